@@ -1,0 +1,63 @@
+/// \file parallel.hpp
+/// OpenMP helpers, optional at build time. Work is split in fixed static chunks
+/// and every reduction is done in a fixed order, so results are identical bit for
+/// bit for any thread count.
+#pragma once
+#include <vector>
+
+#include "config.hpp"
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+namespace parafsi::parallel {
+
+/// Threads the next parallel region will use (1 without OpenMP).
+inline int max_threads() noexcept {
+#if defined(_OPENMP)
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+/// Set the thread count (ignored without OpenMP).
+inline void set_threads([[maybe_unused]] int n) noexcept {
+#if defined(_OPENMP)
+  if (n > 0) omp_set_num_threads(n);
+#endif
+}
+
+/// True when compiled with OpenMP.
+inline constexpr bool enabled() noexcept {
+#if defined(_OPENMP)
+  return true;
+#else
+  return false;
+#endif
+}
+
+/// for i in [begin, end): f(i), iterations split statically over threads.
+/// Use only when iterations write disjoint data.
+template <class F>
+inline void for_range(index_t begin, index_t end, F&& f) {
+#if defined(_OPENMP)
+#pragma omp parallel for schedule(static)
+  for (index_t i = begin; i < end; ++i) f(i);
+#else
+  for (index_t i = begin; i < end; ++i) f(i);
+#endif
+}
+
+/// Deterministic reduction: each index contributes f(i) to a per-index slot and the
+/// slots are combined in index order, so the result does not depend on threads.
+template <class T, class F, class Op>
+inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op) {
+  std::vector<T> part(static_cast<std::size_t>(end > begin ? end - begin : 0), init);
+  for_range(begin, end, [&](index_t i) { part[static_cast<std::size_t>(i - begin)] = f(i); });
+  T acc = init;
+  for (const T& p : part) acc = op(acc, p);
+  return acc;
+}
+
+}  // namespace parafsi::parallel

@@ -1,6 +1,8 @@
 /// \file ausm_plus_up.hpp
 /// AUSM+-up (Liou 2006), all-speed advection upstream splitting:
-///   a½ = min(â_L, â_R),  â_K from the critical speed a*² = 2(γ−1)H/(γ+1);
+///   a½ = ½(â_L + â_R),  â_K from the critical speed a*² = 2(γ−1)H/(γ+1) (Liou's
+///        min(â_L, â_R) collapses to the cold side's speed at pressure ratios ≳ 10⁴, e.g.
+///        Toro's test 3, and drives a huge pressure-diffusion mass flux; the mean is robust);
 ///   M½ = M⁺₍₄₎(M_L) + M⁻₍₄₎(M_R) − (K_p/f_a) max(1 − σ M̄², 0)(p_R − p_L)/(ρ½ a½²),
 ///   p½ = P⁺₍₅₎ p_L + P⁻₍₅₎ p_R − K_u P⁺₍₅₎ P⁻₍₅₎ (ρ_L + ρ_R) f_a a½ (u_nR − u_nL),
 ///   F  = a½ M½ ρ_up (1, u, H)_up + p½ (0, n, 0),
@@ -34,7 +36,7 @@ struct ausm_plus_up {
     const V asL = simd::sqrt(V(gk) * HL), asR = simd::sqrt(V(gk) * HR);
     const V ahL = asL * asL / simd::max(asL, unL);
     const V ahR = asR * asR / simd::max(asR, -unR);
-    const V a = simd::min(ahL, ahR);
+    const V a = V(0.5) * (ahL + ahR);
     const V ML = unL / a, MR = unR / a;
     const V Mbar2 = (unL * unL + unR * unR) / (V(2.0) * a * a);
     const V Mo2 = simd::min(V(1.0), simd::max(Mbar2, V(mach_cutoff * mach_cutoff)));

@@ -1,0 +1,288 @@
+/// \file assembly.hpp
+/// `structure::assembly<Parts...>`: parts (membranes, cables/tapes, rigid bodies with
+/// attached nodes) sharing one node set, advanced by the central-difference update.
+///
+/// One substep (methods §8.3, step 3):
+///   place_attached_nodes → clear_forces (f = m g) → external loads (coupling hook)
+///   → compute_element_forces (every element part, race-free) → scatter_element_forces
+///   → step_bodies (node forces → body force + moment, body leapfrog)
+///   → update_nodes (kick/drift) → check (numerical_failure naming node, element, time).
+/// `advance(Δt_f)` runs m = ceil(Δt_f/Δt_s,crit) equal substeps inside one fluid step,
+/// Δt_s,crit = TSSF · min(membrane element limits, nodal line limits, body limits).
+///
+/// "Off" is a type: the fold runs over exactly the declared parts, so an assembly
+/// without cables or without a rigid body holds no cable or body storage and has no
+/// cable or body pass (`has_cables`, `has_body`, checked by a static test).
+///
+/// Part concept (what the fold calls): element parts provide `finalize(nodes&)`,
+/// `compute_forces<Track>(node_kinematics)`, `scatter<Track>(nodes&)`,
+/// `critical_dt(const nodes&)`, `strain_energy()`, `first_bad_element()` and
+/// optionally `post_finalize(const nodes&)`, `add_node_stiffness(vector&)`,
+/// `damping_ratio()`; body parts (`is_body = true`) provide `finalize`,
+/// `post_finalize`, `place_nodes`, `step`, `critical_dt(ksum)` and momenta/energy.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "central_difference.hpp"
+#include "energy.hpp"
+#include "nodes.hpp"
+
+namespace parafsi::structure {
+
+template <class P>
+concept body_part = requires { P::is_body; } && P::is_body;
+template <class P>
+concept line_part = requires(const P& p, std::vector<double>& k) { p.add_node_stiffness(k); };
+
+/// Adds coupling / user loads to nodes; when energy is tracked they count as external work.
+class load_sink {
+ public:
+  load_sink(nodes& nd, bool track) : s_(nd.data()), track_(track) {}
+  void add(index_t i, const Eigen::Vector3d& f) {
+    s_.get<field::fx>()[i] += f.x(); s_.get<field::fy>()[i] += f.y(); s_.get<field::fz>()[i] += f.z();
+    if (track_) { s_.get<field::fex>()[i] += f.x(); s_.get<field::fey>()[i] += f.y(); s_.get<field::fez>()[i] += f.z(); }
+  }
+ private:
+  nodes::storage& s_;
+  bool track_;
+};
+
+struct no_loads {
+  void operator()(load_sink&, double) const noexcept {}
+};
+
+template <class... Parts>
+class assembly {
+ public:
+  using parts_type = std::tuple<Parts...>;
+  static constexpr std::size_t part_count = sizeof...(Parts);
+  static constexpr std::size_t body_count = (std::size_t(0) + ... + std::size_t(body_part<Parts>));
+  static constexpr std::size_t line_count = (std::size_t(0) + ... + std::size_t(line_part<Parts>));
+  static constexpr bool has_body = body_count > 0;
+  static constexpr bool has_cables = line_count > 0;
+
+  /// Parts in any order; integrator settings (gravity, mass damping, TSSF) through
+  /// integrator().
+  explicit assembly(nodes nd, Parts... parts) : nodes_(std::move(nd)), parts_(std::move(parts)...) {}
+
+  // ------------------------------------------------------------------ access
+  nodes& node_set() noexcept { return nodes_; }
+  const nodes& node_set() const noexcept { return nodes_; }
+  template <std::size_t I>
+  auto& part() noexcept { return std::get<I>(parts_); }
+  template <std::size_t I>
+  const auto& part() const noexcept { return std::get<I>(parts_); }
+  central_difference& integrator() noexcept { return cd_; }
+  double time() const noexcept { return t_; }
+  long steps() const noexcept { return steps_; }
+  /// Composed name, e.g. "assembly<membrane_tri, cable, rigid_body>".
+  static std::string name() {
+    std::string s = "assembly<";
+    bool first = true;
+    ((s += (first ? "" : ", "), s += Parts::name(), first = false), ...);
+    return s + ">";
+  }
+
+  // ------------------------------------------------------------------ set-up
+  /// Validate parts, lump masses, build scatter maps and time-step data. Called
+  /// automatically by the first step and after any constraint change.
+  void finalize() {
+    nodes_.materialize();
+    nodes_.reset_masses();
+    std::apply([&](auto&... p) { (p.finalize(nodes_), ...); }, parts_);
+    nodes_.finalize_masses();
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (requires { p.post_finalize(nodes_); }) p.post_finalize(nodes_);
+      }(), ...);
+    }, parts_);
+    ksum_.assign(std::size_t(nodes_.size()), 0.0);
+    double xi = 0;
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (line_part<std::remove_cvref_t<decltype(p)>>) {
+          p.add_node_stiffness(ksum_);
+          xi = std::max(xi, p.damping_ratio());
+        }
+      }(), ...);
+    }, parts_);
+    dt_nodal_ = std::numeric_limits<double>::infinity();
+    for (index_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_.kind(i) == constraint::free && ksum_[std::size_t(i)] > 0)
+        dt_nodal_ = std::min(dt_nodal_, std::sqrt(2.0 * nodes_.mass(i) / ksum_[std::size_t(i)]));
+    dt_nodal_ *= std::sqrt(1.0 + xi * xi) - xi;
+    nodes_.mark_finalized();
+  }
+
+  // ------------------------------------------------------------------ time step
+  /// Largest stable substep, TSSF · min over parts (s).
+  double stable_dt() {
+    if (nodes_.needs_finalize()) finalize();
+    double dt = dt_nodal_;
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) dt = std::min(dt, p.critical_dt(ksum_));
+        else dt = std::min(dt, p.critical_dt(nodes_));
+      }(), ...);
+    }, parts_);
+    return cd_.tssf * dt;
+  }
+
+  /// Advance by dt_outer in m = ceil(dt_outer/stable_dt()) equal substeps; returns m.
+  template <class Loads = no_loads>
+  long advance(double dt_outer, Loads&& loads = {}) {
+    const long m = central_difference::substeps(dt_outer, stable_dt());
+    const double dt = dt_outer / double(m);
+    for (long k = 0; k < m; ++k) step(dt, loads);
+    return m;
+  }
+
+  /// One substep of length dt. `loads(load_sink&, t)` may add external nodal forces.
+  template <class Loads = no_loads>
+  void step(double dt, Loads&& loads = {}) {
+    require(dt > 0 && std::isfinite(dt), "assembly::step: time step must be > 0, got ", dt);
+    cd_.validate();
+    if (nodes_.needs_finalize()) finalize();
+    if (track_) substep<true>(dt, loads);
+    else substep<false>(dt, loads);
+  }
+
+  // ------------------------------------------------------------------ diagnostics
+  /// Start energy bookkeeping (resets damping and external work to zero).
+  void track_energy(bool on = true) {
+    track_ = on;
+    ledger_ = {};
+    if (on) {
+      if (nodes_.needs_finalize()) finalize();
+      ledger_.kinetic = kinetic_energy();
+    }
+  }
+  const energy_ledger& energy() const noexcept { return ledger_; }
+
+  /// ½ Σ m|v|² over free nodes + rigid bodies (velocities at the last half step).
+  double kinetic_energy() const {
+    double k = 0;
+    for (index_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_.kind(i) == constraint::free) k += 0.5 * nodes_.mass(i) * nodes_.velocity(i).squaredNorm();
+    for_each_body([&](const auto& b) { k += b.kinetic_energy(); });
+    return k;
+  }
+  /// Σ m v over free nodes + bodies.
+  Eigen::Vector3d linear_momentum() const {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (index_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_.kind(i) == constraint::free) p += nodes_.mass(i) * nodes_.velocity(i);
+    for_each_body([&](const auto& b) { p += b.linear_momentum(); });
+    return p;
+  }
+  /// Σ m x × v over free nodes + bodies' angular momentum, about the origin.
+  Eigen::Vector3d angular_momentum() const {
+    Eigen::Vector3d l = Eigen::Vector3d::Zero();
+    for (index_t i = 0; i < nodes_.size(); ++i)
+      if (nodes_.kind(i) == constraint::free) l += nodes_.mass(i) * nodes_.position(i).cross(nodes_.velocity(i));
+    for_each_body([&](const auto& b) { l += b.angular_momentum(); });
+    return l;
+  }
+
+ private:
+  template <class F>
+  void for_each_body(F&& f) const {
+    std::apply([&](const auto&... p) {
+      ((void)[&] {
+        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) f(p);
+      }(), ...);
+    }, parts_);
+  }
+
+  template <bool Track, class Loads>
+  void substep(double dt, Loads& loads) {
+    const double dt_kick = 0.5 * (dt_prev_ + dt);
+    // Phase 1. Attached nodes from the body poses.
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) p.place_nodes(nodes_);
+      }(), ...);
+    }, parts_);
+    // Phase 2. Body loads and external loads.
+    cd_.template clear_forces<Track>(nodes_);
+    {
+      load_sink sink(nodes_, Track);
+      loads(sink, t_);
+    }
+    // Phase 3. Element forces (membranes, cables, tapes), then race-free scatter.
+    const node_kinematics kin = nodes_.kinematics();
+    double strain = 0;
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
+          p.template compute_forces<Track>(kin);
+          p.template scatter<Track>(nodes_);
+          if constexpr (Track) strain += p.strain_energy();
+        }
+      }(), ...);
+    }, parts_);
+    // Phase 4. Rigid bodies.
+    double w_body = 0;
+    std::apply([&](auto&... p) {
+      ((void)[&] {
+        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) w_body += p.step(nodes_, cd_.gravity, dt_kick, dt);
+      }(), ...);
+    }, parts_);
+    // Phase 5. Central-difference update of the nodes.
+    const auto r = cd_.template update<Track>(nodes_, dt_kick, dt);
+    if (r.bad_node >= 0) fail(r.bad_node);
+    if constexpr (Track) {
+      double kb = 0;
+      for_each_body([&](const auto& b) { kb += b.kinetic_energy(); });
+      ledger_.kinetic = r.kinetic + kb;
+      ledger_.strain = strain;
+      ledger_.damping += r.damping;
+      ledger_.external += r.external + w_body;
+    }
+    t_ += dt;
+    dt_prev_ = dt;
+    ++steps_;
+  }
+
+  [[noreturn]] void fail(index_t node) {
+    std::string where;
+    std::apply([&](const auto&... p) {
+      ((void)[&] {
+        if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
+          const index_t e = p.first_bad_element();
+          if (e >= 0 && where.empty()) where = parafsi::detail::concat(" (first non-finite force: ", p.name(), " element ", e, ")");
+        }
+      }(), ...);
+    }, parts_);
+    throw numerical_failure(parafsi::detail::concat("structure::assembly: node ", node, " became non-finite at t = ", t_,
+                                           where, "; the step may exceed stable_dt() = ",
+                                           stable_dt()),
+                            node, t_);
+  }
+
+  nodes nodes_;
+  parts_type parts_;
+  central_difference cd_;
+  std::vector<double> ksum_;
+  double dt_nodal_ = std::numeric_limits<double>::infinity();
+  double t_ = 0, dt_prev_ = 0;
+  long steps_ = 0;
+  bool track_ = false;
+  energy_ledger ledger_{};
+};
+
+/// Deduction: assembly{nodes, part1, part2, ...}.
+template <class... Parts>
+assembly(nodes, Parts...) -> assembly<Parts...>;
+
+}  // namespace parafsi::structure

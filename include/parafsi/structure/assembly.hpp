@@ -31,6 +31,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "../core/error.hpp"
 #include "central_difference.hpp"
@@ -171,9 +172,12 @@ class assembly {
 
   /// ½ Σ m|v|² over free nodes + rigid bodies (velocities at the last half step).
   double kinetic_energy() const {
+    const auto& s = nodes_.data();
+    const double* vx = s.get<field::vx>(); const double* vy = s.get<field::vy>(); const double* vz = s.get<field::vz>();
+    const double* m = s.get<field::m>(); const double* mi = s.get<field::minv>();
     double k = 0;
     for (index_t i = 0; i < nodes_.size(); ++i)
-      if (nodes_.kind(i) == constraint::free) k += 0.5 * nodes_.mass(i) * nodes_.velocity(i).squaredNorm();
+      if (mi[i] > 0) k += 0.5 * m[i] * (vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]);
     for_each_body([&](const auto& b) { k += b.kinetic_energy(); });
     return k;
   }
@@ -194,7 +198,6 @@ class assembly {
     return l;
   }
 
- private:
   template <class F>
   void for_each_body(F&& f) const {
     std::apply([&](const auto&... p) {
@@ -204,9 +207,18 @@ class assembly {
     }, parts_);
   }
 
+  /// Forces at the current state without advancing (phases 1–3 of a substep): the
+  /// node force arrays then hold f = m g + external + element forces. For tests,
+  /// diagnostics and coupling set-up. Returns the strain energy.
+  template <class Loads = no_loads>
+  double evaluate_forces(Loads&& loads = {}) {
+    if (nodes_.needs_finalize()) finalize();
+    return compute_phase<true>(loads);
+  }
+
+ private:
   template <bool Track, class Loads>
-  void substep(double dt, Loads& loads) {
-    const double dt_kick = 0.5 * (dt_prev_ + dt);
+  double compute_phase(Loads& loads) {
     // Phase 1. Attached nodes from the body poses.
     std::apply([&](auto&... p) {
       ((void)[&] {
@@ -221,7 +233,7 @@ class assembly {
     }
     // Phase 3. Element forces (membranes, cables, tapes), then race-free scatter.
     const node_kinematics kin = nodes_.kinematics();
-    double strain = 0;
+    double strain = 0;  // filled when Track
     std::apply([&](auto&... p) {
       ((void)[&] {
         if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
@@ -231,6 +243,13 @@ class assembly {
         }
       }(), ...);
     }, parts_);
+    return strain;
+  }
+
+  template <bool Track, class Loads>
+  void substep(double dt, Loads& loads) {
+    const double dt_kick = 0.5 * (dt_prev_ + dt);
+    const double strain = compute_phase<Track>(loads);
     // Phase 4. Rigid bodies.
     double w_body = 0;
     std::apply([&](auto&... p) {

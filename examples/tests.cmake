@@ -1,0 +1,115 @@
+# Smoke tests of the example programs (included from examples/CMakeLists.txt when
+# tests are on): each program runs briefly on a small grid, --help works, bad flags
+# fail, CSV headers are exact, and moving_box's pass/fail exit code is honoured.
+# Total run time: well under two minutes on a 2-core machine.
+
+set(_ex_out ${CMAKE_CURRENT_BINARY_DIR}/test_output)
+file(MAKE_DIRECTORY ${_ex_out})
+
+# Helper script: run a program, require exit code 0, then require that the first
+# line of the CSV named OUT equals HEADER and that it has ROWS data rows.
+set(_ex_check ${CMAKE_CURRENT_BINARY_DIR}/run_and_check_csv.cmake)
+file(WRITE ${_ex_check} [=[
+file(REMOVE ${OUT})
+string(REPLACE "|" ";" ARGS "${ARGS}")
+execute_process(COMMAND ${PROGRAM} ${ARGS} --out ${OUT} RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${PROGRAM} exited with ${rc}:\n${err}")
+endif()
+if(NOT EXISTS ${OUT})
+  message(FATAL_ERROR "${PROGRAM} wrote no ${OUT}")
+endif()
+file(STRINGS ${OUT} lines)
+list(LENGTH lines n)
+list(GET lines 0 first)
+if(NOT first STREQUAL HEADER)
+  message(FATAL_ERROR "${OUT}: header '${first}', expected '${HEADER}'")
+endif()
+math(EXPR rows "${n} - 1")
+if(NOT rows EQUAL ROWS)
+  message(FATAL_ERROR "${OUT}: ${rows} data rows, expected ${ROWS}")
+endif()
+if(DEFINED EXPECT AND NOT out MATCHES "${EXPECT}")
+  message(FATAL_ERROR "output does not match '${EXPECT}'")
+endif()
+]=])
+
+# parafsi_example_csv_test(NAME PROGRAM HEADER ROWS EXPECT args...)
+function(parafsi_example_csv_test name program header rows expect)
+  list(JOIN ARGN "|" _args)  # passed as one -D value, split again by the script
+  add_test(NAME ${name}
+    COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:${program}> "-DARGS=${_args}"
+            -DOUT=${_ex_out}/${name}.csv "-DHEADER=${header}" -DROWS=${rows} "-DEXPECT=${expect}"
+            -P ${_ex_check})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 120 LABELS examples)
+endfunction()
+
+# parafsi_example_test(NAME PROGRAM args...): exit code 0.
+function(parafsi_example_test name program)
+  add_test(NAME ${name} COMMAND ${program} ${ARGN})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 120 LABELS examples)
+endfunction()
+
+# parafsi_example_fails(NAME PROGRAM args...): must exit non-zero.
+function(parafsi_example_fails name program)
+  add_test(NAME ${name} COMMAND ${program} ${ARGN})
+  set_tests_properties(${name} PROPERTIES WILL_FAIL TRUE TIMEOUT 60 LABELS examples)
+endfunction()
+
+# Bad flags on otherwise valid command lines (moving_box takes no --out).
+foreach(prog IN ITEMS shock_tube isentropic_vortex gresho_vortex moving_box)
+  set(out --out ${_ex_out}/unused.csv)
+  if(prog STREQUAL "moving_box")
+    set(out --steps 10)
+  endif()
+  parafsi_example_test(example_${prog}_help ${prog} --help)
+  parafsi_example_fails(example_${prog}_unknown_flag ${prog} --no-such-flag 1 ${out})
+  parafsi_example_fails(example_${prog}_bad_flux ${prog} --flux foo ${out})
+  parafsi_example_fails(example_${prog}_bad_limiter ${prog} --limiter superbee ${out})
+  parafsi_example_fails(example_${prog}_zero_cells ${prog} --cells 0 ${out})
+  parafsi_example_fails(example_${prog}_bad_cfl ${prog} --cfl 1.5 ${out})
+endforeach()
+
+# ---- shock_tube: every problem, flux, limiter and axis at least once (100 cells).
+parafsi_example_csv_test(example_shock_tube_sod shock_tube "x,rho,u,p" 100 "l1_rho="
+  --problem sod --flux hllc_lm --limiter van_leer --cells 100 --axis x)
+parafsi_example_csv_test(example_shock_tube_lax shock_tube "x,rho,u,p" 100 "l1_rho="
+  --problem lax --flux hllc --limiter minmod --cells 100 --axis y)
+parafsi_example_csv_test(example_shock_tube_toro2 shock_tube "x,rho,u,p" 100 "l1_rho="
+  --problem toro2 --flux rusanov --limiter mc --cells 100 --axis z)
+parafsi_example_csv_test(example_shock_tube_toro3 shock_tube "x,rho,u,p" 100 "l1_rho="
+  --problem toro3 --flux ausm_plus_up --limiter none --cells 100 --axis x)
+parafsi_example_csv_test(example_shock_tube_t_end shock_tube "x,rho,u,p" 50 "t_end=0.05"
+  --problem sod --cells 50 --axis y --t-end 0.05)
+parafsi_example_fails(example_shock_tube_bad_problem shock_tube --problem toro9 --out ${_ex_out}/unused.csv)
+parafsi_example_fails(example_shock_tube_bad_axis shock_tube --axis w --out ${_ex_out}/unused.csv)
+parafsi_example_fails(example_shock_tube_no_out shock_tube --problem sod)
+parafsi_example_fails(example_shock_tube_negative_t_end shock_tube --t-end -1 --out ${_ex_out}/unused.csv)
+
+# ---- isentropic_vortex: one period on 16 x 16 (and a low-Mach variant).
+parafsi_example_csv_test(example_isentropic_vortex isentropic_vortex "x,y,rho,u,v,p" 256 "l1_density_error="
+  --cells 16)
+parafsi_example_csv_test(example_isentropic_vortex_mach isentropic_vortex "x,y,rho,u,v,p" 256 "l1_density_error="
+  --cells 16 --mach 0.5 --flux ausm_plus_up --limiter mc --t-end 2)
+parafsi_example_fails(example_isentropic_vortex_bad_mach isentropic_vortex --mach 0 --out ${_ex_out}/unused.csv)
+parafsi_example_fails(example_isentropic_vortex_no_out isentropic_vortex --cells 16)
+
+# ---- gresho_vortex: 16 x 16, short run.
+parafsi_example_csv_test(example_gresho_vortex gresho_vortex "x,y,rho,u,v,p" 256 "kinetic_energy_ratio="
+  --mach 0.1 --cells 16 --t-end 0.1)
+parafsi_example_csv_test(example_gresho_vortex_hllc gresho_vortex "x,y,rho,u,v,p" 256 "kinetic_energy_ratio="
+  --mach 0.01 --cells 16 --flux hllc --t-end 0.01)
+parafsi_example_fails(example_gresho_vortex_bad_mach gresho_vortex --mach -0.1 --cells 16 --out ${_ex_out}/unused.csv)
+parafsi_example_fails(example_gresho_vortex_bad_t_end gresho_vortex --t-end abc --out ${_ex_out}/unused.csv)
+
+# ---- moving_box: the default run (16^3, 10^4 steps) must pass; other fluxes briefly;
+#      an impossible tolerance must make it exit non-zero.
+parafsi_example_test(example_moving_box moving_box)
+set_tests_properties(example_moving_box PROPERTIES PASS_REGULAR_EXPRESSION "free_stream_preservation=PASS")
+foreach(f IN ITEMS hllc rusanov ausm_plus_up)
+  parafsi_example_test(example_moving_box_${f} moving_box --flux ${f} --limiter mc --cells 8 --steps 500)
+endforeach()
+parafsi_example_fails(example_moving_box_detects_failure moving_box --cells 8 --steps 50 --tolerance 1e-300)
+parafsi_example_fails(example_moving_box_bad_steps moving_box --steps 0)

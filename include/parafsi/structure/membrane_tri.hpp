@@ -11,7 +11,8 @@
 ///   f_a^p   = (p/6) (x_1 − x_0) × (x_2 − x_0)   (pressure p > 0 pushes along the
 ///             counter-clockwise normal of corners 0,1,2)
 ///   m_a    += ρ_A A0 / 3   (lumped, reference area)
-///   Δt_e    = (√(1+ζ²) − ζ) · (2A / max edge) / c,  current geometry (§5.5).
+///   Δt_e    = (√(1+ζ²) − ζ) · (2A0 / max edge0) / (c · max(1, λ_max))   (§5.5; reference
+///             altitude, scaled by the largest current stretch — see critical_dt()).
 /// The fibre frame comes from the reference geometry and convects with F, so a rigid
 /// rotation leaves E (and S) exactly zero and the law is objective. The reference can
 /// differ from the initial positions (a folded canopy remembers its cut pattern).
@@ -112,6 +113,7 @@ class membrane_tri {
     for (auto& c : conn_) c.assign(std::size_t(np_) + simd::width, 0);
     for (auto& a : ref_) a.assign(std::size_t(np_) + simd::width, 0.0);
     a0t_.assign(std::size_t(np_) + simd::width, 0.0);
+    lc0_.assign(std::size_t(n_), 0.0);
     // Without a given reference, the positions at the first finalize become the
     // stress-free state (kept for later re-finalizes, e.g. after pinning a node).
     if (mesh_.reference.empty()) auto_reference_ = true;
@@ -156,6 +158,7 @@ class membrane_tri {
       a0t_[std::size_t(e)] = 0.5 * A2 * mat_.thickness;
       const double lmax = std::sqrt(std::max({(X1 - X0).squaredNorm(), (X2 - X1).squaredNorm(), (X0 - X2).squaredNorm()}));
       lc_min = std::min(lc_min, A2 / lmax);
+      lc0_[std::size_t(e)] = A2 / lmax;
     }
     beta_ = n_ > 0 ? opt_.damping_ratio * lc_min / mat_.wave_speed() : 0.0;
     std::array<std::vector<index_t>, 3> cn;
@@ -181,18 +184,25 @@ class membrane_tri {
   /// Strain energy Σ A0 t ½ S:E (filtered S) from the last tracked evaluation (J).
   double strain_energy() const { return impl::ordered_sum(energy_part_); }
 
-  /// Stable step of the part, current geometry (s).
+  /// Stable step of the part (s): Δt_e = (√(1+ζ²) − ζ) · L_c0 / (c · max(1, λ_max)), L_c0 = 2A0/max
+  /// edge of the reference triangle and λ_max the largest principal stretch now. In the
+  /// total-Lagrangian CST the stiffness is A0 t (F∇N)ᵀQ(F∇N), so the highest frequency
+  /// scales with λ_max c/L_c0; a folded (slack, crumpled) element does not shrink the
+  /// step as a current-altitude estimate would (it may have zero current area).
   double critical_dt(const nodes& nd) const {
-    double lc = std::numeric_limits<double>::infinity();
+    const node_kinematics k = nd.kinematics();
+    double rate = 0;  // max λ_max / L_c0
     for (index_t e = 0; e < n_; ++e) {
-      const Eigen::Vector3d x0 = nd.position(conn_[0][std::size_t(e)]), x1 = nd.position(conn_[1][std::size_t(e)]),
-                            x2 = nd.position(conn_[2][std::size_t(e)]);
-      const double A2 = (x1 - x0).cross(x2 - x0).norm();
-      const double lmax = std::sqrt(std::max({(x1 - x0).squaredNorm(), (x2 - x1).squaredNorm(), (x0 - x2).squaredNorm()}));
-      if (lmax > 0) lc = std::min(lc, A2 / lmax);
+      vec3<double> F1, F2;
+      double E11, E22, E12;
+      strains<double>(k, e, F1, F2, E11, E22, E12);
+      const double C11 = 1 + 2 * E11, C22 = 1 + 2 * E22, C12 = 2 * E12;
+      const double l2 = 0.5 * (C11 + C22) + std::sqrt(0.25 * (C11 - C22) * (C11 - C22) + C12 * C12);
+      rate = std::max(rate, std::sqrt(std::max(1.0, l2)) / lc0_[std::size_t(e)]);
     }
     const double z = opt_.damping_ratio;
-    return lc / mat_.wave_speed() * (std::sqrt(1.0 + z * z) - z);
+    return rate > 0 ? (std::sqrt(1.0 + z * z) - z) / (rate * mat_.wave_speed())
+                    : std::numeric_limits<double>::infinity();
   }
 
   /// First element with a non-finite corner force (-1 if none), for failure reports.
@@ -341,6 +351,7 @@ class membrane_tri {
   std::array<simd::aligned_vector<index_t>, 3> conn_;
   std::array<simd::aligned_vector<double>, 6> ref_;  // b0 b1 b2 c0 c1 c2
   simd::aligned_vector<double> a0t_, p_;
+  std::vector<double> lc0_;  // reference altitude 2A0/max edge
   impl::corner_buffer f_, fd_, fe_;
   impl::corner_scatter scatter_;
   std::vector<double> energy_part_;

@@ -28,6 +28,10 @@ inline index_t chunk_count(index_t n) { return (n + chunk - 1) / chunk; }
 template <class F>
 inline void for_each_chunk(index_t n, F&& f) {
   const index_t nc = chunk_count(n);
+  if (nc <= 1) {  // one chunk: no parallel region (its fork/join would dominate)
+    if (n > 0) f(0, n, 0);
+    return;
+  }
   parallel::for_range(0, nc, [&](index_t c) { f(c * chunk, std::min(n, (c + 1) * chunk), c); });
 }
 

@@ -16,6 +16,7 @@ struct reconstruction {};
 struct turbulence {};
 struct viscosity {};
 struct frame {};
+struct time {};
 }  // namespace kind
 
 template <class T>

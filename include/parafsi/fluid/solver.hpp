@@ -41,6 +41,8 @@
 #include "gas.hpp"
 #include "grid.hpp"
 #include "reconstruction/muscl.hpp"
+#include "time/ssp_rk2.hpp"
+#include "time/ssp_rk3.hpp"
 #include "turbulence/none.hpp"
 #include "viscosity/inviscid.hpp"
 
@@ -96,7 +98,7 @@ struct totals {
 
 template <class Flux = flux::hllc_lm, class Recon = recon::muscl<limiter::van_leer>,
           class Turbulence = turbulence::none, class Viscosity = viscosity::inviscid,
-          class Frame = frame::fixed>
+          class Frame = frame::fixed, class Time = time::ssp_rk2>
 class solver {
  public:
   using flux_type = Flux;
@@ -104,6 +106,7 @@ class solver {
   using turbulence_type = Turbulence;
   using viscosity_type = Viscosity;
   using frame_type = Frame;
+  using time_type = Time;
   static constexpr bool is_viscous = Viscosity::active || Turbulence::active;
   static constexpr bool has_eddy_viscosity = Turbulence::active;
   static constexpr bool needs_wall_distance = [] {
@@ -135,9 +138,10 @@ class solver {
     static_assert(((count_kind_v<kind::gas, Ps...> <= 1) && (count_kind_v<kind::flux, Ps...> <= 1) &&
                    (count_kind_v<kind::reconstruction, Ps...> <= 1) &&
                    (count_kind_v<kind::turbulence, Ps...> <= 1) &&
-                   (count_kind_v<kind::viscosity, Ps...> <= 1) && (count_kind_v<kind::frame, Ps...> <= 1)),
+                   (count_kind_v<kind::viscosity, Ps...> <= 1) && (count_kind_v<kind::frame, Ps...> <= 1) &&
+                   (count_kind_v<kind::time, Ps...> <= 1)),
                   "fluid::solver: at most one policy of each kind (gas, flux, reconstruction, "
-                  "turbulence, viscosity, frame) may be given");
+                  "turbulence, viscosity, frame, time) may be given");
     gas_.validate();
     if constexpr (requires { visc_.validate(); }) visc_.validate();
     if constexpr (requires { turb_.validate(); }) turb_.validate();
@@ -222,7 +226,7 @@ class solver {
   /// Composed policy names, for logs.
   std::string name() const {
     return std::string("fluid::solver<") + Flux::name() + ", muscl:" + Recon::name() + ", " +
-           Turbulence::name() + ", " + Viscosity::name() + ", " + Frame::name() + ">";
+           Turbulence::name() + ", " + Viscosity::name() + ", " + Frame::name() + ", " + Time::name() + ">";
   }
 
   /// Enable the per-cell source hook (momentum N/m³ and energy W/m³, inertial),
@@ -324,18 +328,24 @@ class solver {
     return cfl / lam;
   }
 
-  /// One SSP-RK2 step of size dt (the frame plans the box motion for the step first).
+  /// One Runge–Kutta step of size dt (SSP-RK2 or SSP-RK3 in Shu–Osher form). The
+  /// frame plans the box motion for the step first; every stage uses the box pose at
+  /// its own time tⁿ + c_s Δt.
   void step(double dt) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::solver::step: dt must be positive and finite, got ", dt);
     frame_.plan(pose_, t_, dt);
     copy_state(U0_, U_);
-    // Stage 1 at t^n with the pose at t^n.
-    compute_rhs(t_);
-    update(0.0, 1.0, dt, t_ + dt, /*check=*/false);
-    // The box moves to its pose at t^{n+1}; stage 2 uses it.
-    pose_.advance(dt);
-    compute_rhs(t_ + dt);
-    update(0.5, 0.5, dt, t_ + dt, /*check=*/true);
+    double pose_time = 0.0;  // offset of the current pose from tⁿ
+    for (int s = 0; s < Time::stages; ++s) {
+      const double c = Time::c[std::size_t(s)];
+      if (c != pose_time) {
+        pose_.advance((c - pose_time) * dt);  // exact for the step's rigid motion
+        pose_time = c;
+      }
+      compute_rhs(t_ + c * dt);
+      update(Time::a[std::size_t(s)], Time::b[std::size_t(s)], dt, t_ + dt, /*check=*/s + 1 == Time::stages);
+    }
+    if (pose_time != 1.0) pose_.advance((1.0 - pose_time) * dt);
     t_ += dt;
     ++steps_;
   }
@@ -910,6 +920,6 @@ solver(rectilinear_grid, boundary::set, const Ps&...)
     -> solver<pick_t<kind::flux, flux::hllc_lm, Ps...>,
               pick_t<kind::reconstruction, recon::muscl<limiter::van_leer>, Ps...>,
               pick_t<kind::turbulence, turbulence::none, Ps...>, pick_t<kind::viscosity, viscosity::inviscid, Ps...>,
-              pick_t<kind::frame, frame::fixed, Ps...>>;
+              pick_t<kind::frame, frame::fixed, Ps...>, pick_t<kind::time, time::ssp_rk2, Ps...>>;
 
 }  // namespace parafsi::fluid

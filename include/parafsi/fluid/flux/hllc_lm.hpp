@@ -5,6 +5,11 @@
 ///   F* = ½(F_L + F_R) + ½[φ S_L (U*_L − U_L) + |S*| (U*_L − U*_R) + φ S_R (U*_R − U_R)],
 ///   φ = sin(min(1, M_loc / M_lim) π/2),  M_loc = max(|u_nL|/c_L, |u_nR|/c_R),  M_lim = 0.1.
 /// With φ = 1 the central form equals HLLC algebraically (a unit test checks it).
+/// φ is floored at φ_min = 0.1 (our choice, not the paper's): with φ → 0 the acoustic
+/// part of the flux becomes central, and with a limited MUSCL reconstruction acoustic
+/// waves in still air then grow grid-scale noise (a 10 Pa pulse leaves ±1 Pa noise,
+/// with SSP-RK2 or SSP-RK3 alike). The floor only acts below M_loc ≈ 0.006, far under
+/// the parachute's M ≈ 0.02; set phi_min = 0 for the paper's original form.
 /// References: Fleischmann N., Adami S., Adams N.A. (2020) J. Comput. Phys. 423:109762,
 ///   doi:10.1016/j.jcp.2020.109762.
 #pragma once
@@ -17,6 +22,7 @@ namespace parafsi::flux {
 
 struct hllc_lm {
   double mach_limit = 0.1;  ///< M_lim: below it the acoustic dissipation is scaled down
+  double phi_min = 0.1;      ///< floor on φ: acoustic damping kept below M ≈ 0.006 (see above)
 
   using policy_kind = kind::flux;
   static constexpr const char* name() noexcept { return "hllc_lm"; }
@@ -28,7 +34,8 @@ struct hllc_lm {
     const auto h = detail::hllc_prepare(L, R, n, g);
     const V cL = g.sound_speed(L.rho, L.p), cR = g.sound_speed(R.rho, R.p);
     const V mloc = simd::max(simd::abs(h.unL) / cL, simd::abs(h.unR) / cR);
-    const V phi = simd::sin(simd::min(V(1.0), mloc * V(1.0 / mach_limit)) * V(0.5 * std::numbers::pi));
+    const V phi0 = simd::sin(simd::min(V(1.0), mloc * V(1.0 / mach_limit)) * V(0.5 * std::numbers::pi));
+    const V phi = simd::max(phi0, V(phi_min));
     const auto central = (h.FL + h.FR) * V(0.5) +
                          ((h.UsL - h.UL) * (phi * h.SL) + (h.UsL - h.UsR) * simd::abs(h.Sstar) +
                           (h.UsR - h.UR) * (phi * h.SR)) * V(0.5);

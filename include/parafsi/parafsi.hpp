@@ -12,3 +12,4 @@
 #include "core/vec3.hpp"
 
 #include "fluid/fluid.hpp"
+#include "structure/structure.hpp"

@@ -15,10 +15,12 @@ namespace parafsi::flux::detail {
 
 template <class V>
 struct hllc_waves {
-  V unL, unR, EL, ER, SL, SR, Sstar;
+  V unL, unR, cL, cR, EL, ER, SL, SR, Sstar;
   fluid::cons<V> UL, UR, FL, FR, UsL, UsR;
 };
 
+/// Wave speeds, star states and the two side fluxes, with one reciprocal per density
+/// and per star denominator (divisions dominate the cost of this kernel).
 template <class V>
 PARAFSI_INLINE hllc_waves<V> hllc_prepare(const fluid::prim<V>& L, const fluid::prim<V>& R,
                                           const vec3<double>& n, const gas::ideal& g) noexcept {
@@ -26,34 +28,38 @@ PARAFSI_INLINE hllc_waves<V> hllc_prepare(const fluid::prim<V>& L, const fluid::
   hllc_waves<V> h;
   h.unL = dot(L.u, n);
   h.unR = dot(R.u, n);
-  const V cL = g.sound_speed(L.rho, L.p), cR = g.sound_speed(R.rho, R.p);
+  const V irL = V(1.0) / L.rho, irR = V(1.0) / R.rho;
+  h.cL = simd::sqrt(V(g.gamma) * L.p * irL);
+  h.cR = simd::sqrt(V(g.gamma) * R.p * irR);
   h.EL = g.total_energy(L.rho, L.u.x, L.u.y, L.u.z, L.p);
   h.ER = g.total_energy(R.rho, R.u.x, R.u.y, R.u.z, R.p);
   // Einfeldt (Roe-averaged) speeds bounded by the Davis estimates.
   const V sL = simd::sqrt(L.rho), sR = simd::sqrt(R.rho);
   const V inv = V(1.0) / (sL + sR);
-  const V un_roe = (sL * h.unL + sR * h.unR) * inv;
-  const V HL = (h.EL + L.p) / L.rho, HR = (h.ER + R.p) / R.rho;
-  const V H_roe = (sL * HL + sR * HR) * inv;
-  const vec3<V> u_roe = (L.u * sL + R.u * sR) * inv;
+  const V wL = sL * inv, wR = sR * inv;
+  const V un_roe = wL * h.unL + wR * h.unR;
+  const V HL = (h.EL + L.p) * irL, HR = (h.ER + R.p) * irR;
+  const V H_roe = wL * HL + wR * HR;
+  const vec3<V> u_roe = L.u * wL + R.u * wR;
   const V q2 = dot(u_roe, u_roe);
   const V c_roe = simd::sqrt(simd::max(V(g.gamma - 1.0) * (H_roe - V(0.5) * q2), V(1e-300)));
-  h.SL = simd::min(h.unL - cL, un_roe - c_roe);
-  h.SR = simd::max(h.unR + cR, un_roe + c_roe);
+  h.SL = simd::min(h.unL - h.cL, un_roe - c_roe);
+  h.SR = simd::max(h.unR + h.cR, un_roe + c_roe);
   const V dL = L.rho * (h.SL - h.unL), dR = R.rho * (h.SR - h.unR);
   h.Sstar = (R.p - L.p + dL * h.unL - dR * h.unR) / (dL - dR);
   h.UL = {L.rho, L.u * L.rho, h.EL};
   h.UR = {R.rho, R.u * R.rho, h.ER};
   h.FL = physical_flux(L, h.EL, h.unL, n);
   h.FR = physical_flux(R, h.ER, h.unR, n);
-  auto star = [&](const prim<V>& W, const V& E, const V& un, const V& S, const V& d) {
-    const V f = d / (S - h.Sstar);
+  auto star = [&](const prim<V>& W, const V& E, const V& ir, const V& un, const V& S, const V& d) {
+    // f (S* − u_n) p/d = (S* − u_n) p/(S − S*): one reciprocal r = 1/(S − S*) serves both.
+    const V r = V(1.0) / (S - h.Sstar);
+    const V f = d * r;
     const V ds = h.Sstar - un;
-    return cons<V>{f, axpy_n(W.u, ds, n) * f,
-                   f * (E / W.rho + ds * (h.Sstar + W.p / d))};
+    return cons<V>{f, axpy_n(W.u, ds, n) * f, f * (E * ir + ds * h.Sstar) + ds * W.p * r};
   };
-  h.UsL = star(L, h.EL, h.unL, h.SL, dL);
-  h.UsR = star(R, h.ER, h.unR, h.SR, dR);
+  h.UsL = star(L, h.EL, irL, h.unL, h.SL, dL);
+  h.UsR = star(R, h.ER, irR, h.unR, h.SR, dR);
   return h;
 }
 

@@ -27,14 +27,26 @@ struct hllc_lm {
   using policy_kind = kind::flux;
   static constexpr const char* name() noexcept { return "hllc_lm"; }
 
+  /// sin(π x / 2) on [0, 1] by its Taylor series to x⁹ (|error| ≤ 3.6e-6, exact 1 at x = 1):
+  /// a few FMAs instead of a full SIMD sine with range reduction.
+  template <class V>
+  static PARAFSI_INLINE V sin_half_pi(const V& x) noexcept {
+    constexpr double a = 0.5 * std::numbers::pi;
+    constexpr double c1 = a, c3 = -a * a * a / 6, c5 = a * a * a * a * a / 120,
+                     c7 = -a * a * a * a * a * a * a / 5040, c9 = a * a * a * a * a * a * a * a * a / 362880;
+    const V x2 = x * x;
+    const V s = x * (V(c1) + x2 * (V(c3) + x2 * (V(c5) + x2 * (V(c7) + x2 * V(c9)))));
+    return simd::select(x >= V(1.0), V(1.0), s);
+  }
+
   template <class V>
   PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R,
                                            const vec3<double>& n, const gas::ideal& g) const noexcept {
     using fluid::select;
     const auto h = detail::hllc_prepare(L, R, n, g);
-    const V cL = g.sound_speed(L.rho, L.p), cR = g.sound_speed(R.rho, R.p);
-    const V mloc = simd::max(simd::abs(h.unL) / cL, simd::abs(h.unR) / cR);
-    const V phi0 = simd::sin(simd::min(V(1.0), mloc * V(1.0 / mach_limit)) * V(0.5 * std::numbers::pi));
+    // M_loc = max(|u_nL|/c_L, |u_nR|/c_R) with one division.
+    const V mloc = simd::max(simd::abs(h.unL) * h.cR, simd::abs(h.unR) * h.cL) / (h.cL * h.cR);
+    const V phi0 = sin_half_pi(simd::min(V(1.0), mloc * V(1.0 / mach_limit)));
     const V phi = simd::max(phi0, V(phi_min));
     const auto central = (h.FL + h.FR) * V(0.5) +
                          ((h.UsL - h.UL) * (phi * h.SL) + (h.UsL - h.UsR) * simd::abs(h.Sstar) +

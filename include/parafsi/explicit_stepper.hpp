@@ -1,0 +1,166 @@
+/// \file explicit_stepper.hpp
+/// `explicit_stepper<Fluid, Structure, Coupling>`: one step of the coupled system as a
+/// short recipe of named, timed phases (DESIGN §4, methods §8.3):
+///
+///   1. move_frame  — plan the box motion over the step (the frame policy's plan on a
+///                    copy of the pose; the fluid step applies the same plan);
+///   2. exchange    — snapshot the fluid at tⁿ (velocity, ρ, K = γp), coupling stiffness
+///                    and its caps, travel check, clear the fluid's source arrays;
+///   3. structure   — m = ceil(Δt_f / Δt_s,crit) equal substeps, Δt_s,crit = min(assembly
+///                    limit, coupling-spring limit); coupling forces enter each substep
+///                    through the assembly's load hook, their reactions are accumulated
+///                    as fluid impulses;
+///   4. fluid       — impulses → sources (J, W)/(Δt_f V_cell), one fluid step;
+///   5. time        — t += Δt_f.
+///
+/// Leaving a part out: `no_fluid` or `no_structure` in its place (with
+/// `coupling::none`) removes its storage and its passes at compile time:
+///   explicit_stepper s{no_fluid{}, std::move(assembly)};   // structure only
+///   explicit_stepper s{std::move(solver), no_structure{}}; // fluid only
+/// Momentum: what the structure gains, the air loses (same kick lengths on both sides),
+/// to round-off, every step (tests/test_coupling_impulse.cpp).
+/// Frame tracking (follow_payload) is the user's: call fluid().frame().track(...)
+/// before step() (the drop scene does it from the payload state).
+#pragma once
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <utility>
+
+#include "core/error.hpp"
+#include "coupling/none.hpp"
+#include "structure/assembly.hpp"
+#include "structure/central_difference.hpp"
+
+namespace parafsi {
+
+/// Placeholders for a part left out of a stepper (no storage, no pass).
+struct no_fluid {};
+struct no_structure {};
+
+/// Accumulated wall-clock seconds per phase.
+struct stepper_phase_times {
+  double move_frame = 0, exchange = 0, structure = 0, fluid = 0;
+  double total() const { return move_frame + exchange + structure + fluid; }
+};
+
+template <class Fluid, class Structure, class Coupling = coupling::none>
+class explicit_stepper {
+ public:
+  static constexpr bool has_fluid = !std::is_same_v<Fluid, no_fluid>;
+  static constexpr bool has_structure = !std::is_same_v<Structure, no_structure>;
+  static constexpr bool coupled = Coupling::active;
+  static_assert(has_fluid || has_structure, "explicit_stepper: give a fluid solver, a structure assembly or both");
+  static_assert(!coupled || (has_fluid && has_structure),
+                "explicit_stepper: a coupling needs both a fluid and a structure; use coupling::none with "
+                "no_fluid or no_structure");
+
+  explicit_stepper(Fluid f, Structure s, Coupling c = {})
+      : fluid_(std::move(f)), structure_(std::move(s)), coupling_(std::move(c)) {
+    if constexpr (has_structure) {
+      if (structure_.node_set().needs_finalize()) structure_.finalize();
+      prev_substep_ = structure_.steps() == 0 ? 0.0 : -1.0;
+    }
+    if constexpr (coupled) coupling_.attach(fluid_, structure_);
+    if constexpr (has_fluid) t_ = fluid_.time();
+    else t_ = structure_.time();
+  }
+
+  // ------------------------------------------------------------- views
+  double time() const noexcept { return t_; }
+  long steps() const noexcept { return steps_; }
+  const Fluid& fluid() const noexcept requires has_fluid { return fluid_; }
+  Fluid& fluid() noexcept requires has_fluid { return fluid_; }
+  const Structure& structure() const noexcept requires has_structure { return structure_; }
+  Structure& structure() noexcept requires has_structure { return structure_; }
+  const Coupling& coupling() const noexcept { return coupling_; }
+  Coupling& coupling() noexcept { return coupling_; }
+  /// Structure substeps of the last step.
+  long last_substeps() const noexcept { return last_m_; }
+  const stepper_phase_times& timings() const noexcept { return times_; }
+  void reset_timings() noexcept { times_ = {}; }
+  /// Upper bound on substeps per fluid step; more is an error naming the cause.
+  long max_substeps = 10000;
+
+  // ------------------------------------------------------------- stepping
+  /// Largest stable step: the fluid's CFL step (and the coupling's travel limit);
+  /// structure-only: the assembly's stable substep.
+  double stable_dt(double cfl = 0.5) {
+    if constexpr (has_fluid) {
+      double dt = fluid_.stable_dt(cfl);
+      if constexpr (coupled) dt = std::min(dt, coupling_.travel_dt(fluid_, structure_));
+      return dt;
+    } else {
+      return structure_.stable_dt();
+    }
+  }
+
+  void step(double dt) {
+    require(dt > 0 && std::isfinite(dt), "explicit_stepper::step: dt must be > 0 and finite, got ", dt);
+    if constexpr (coupled) {
+      timed(times_.move_frame, [&] { coupling_.plan(fluid_, dt); });
+      timed(times_.exchange, [&] { coupling_.exchange(fluid_, structure_, dt); });
+    }
+    if constexpr (has_structure) {
+      timed(times_.structure, [&] {
+        double crit = structure_.stable_dt();
+        if constexpr (coupled) crit = std::min(crit, coupling_.structure_dt());
+        const long m = structure::central_difference::substeps(dt, crit);
+        if (m > max_substeps)
+          throw invalid_input(detail::concat("explicit_stepper::step: the structure needs ", m,
+                                             " substeps in a step of ", dt, " s (stable substep ", crit,
+                                             " s, max_substeps = ", max_substeps,
+                                             "); reduce the fluid step or the coupling stiffness (PFAC)"));
+        const double ds = dt / double(m);
+        for (long k = 0; k < m; ++k) {
+          const double prev = prev_substep_ < 0 ? ds : prev_substep_;
+          const double kick = 0.5 * (prev + ds);
+          if constexpr (coupled) {
+            const double tau = double(k) * ds;
+            structure_.step(ds, [&](structure::load_sink& sink, double) {
+              coupling_.apply(sink, structure_.node_set(), tau, kick, ds);
+            });
+          } else {
+            structure_.step(ds);
+          }
+          prev_substep_ = ds;
+        }
+        last_m_ = m;
+      });
+    }
+    if constexpr (has_fluid) {
+      timed(times_.fluid, [&] {
+        if constexpr (coupled) coupling_.finish(fluid_, dt);
+        fluid_.step(dt);
+      });
+    }
+    t_ += dt;
+    ++steps_;
+  }
+
+ private:
+  template <class F>
+  static void timed(double& acc, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    acc += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  [[no_unique_address]] Fluid fluid_;
+  [[no_unique_address]] Structure structure_;
+  [[no_unique_address]] Coupling coupling_;
+  double t_ = 0;
+  double prev_substep_ = 0;
+  long steps_ = 0;
+  long last_m_ = 0;
+  stepper_phase_times times_{};
+};
+
+template <class F, class S>
+explicit_stepper(F, S) -> explicit_stepper<F, S, coupling::none>;
+template <class F, class S, class C>
+explicit_stepper(F, S, C) -> explicit_stepper<F, S, C>;
+
+}  // namespace parafsi

@@ -1,0 +1,449 @@
+// Belytschko–Tsay one-point quad membrane: patch test, objectivity, orthotropic moduli,
+// hourglass control, set-up rejection, critical step vs the exact element frequency,
+// scalar ≡ SIMD and thread independence, energy balance, and agreement with the CST
+// triangle and Föppl–Hencky on the clamped circular membrane.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include <parafsi/core/parallel.hpp>
+#include <parafsi/model/disk_mesh.hpp>
+#include <parafsi/model/disk_quad_mesh.hpp>
+#include <parafsi/structure/assembly.hpp>
+#include <parafsi/structure/membrane_quad.hpp>
+#include <parafsi/structure/membrane_tri.hpp>
+#include <parafsi/structure/reference/hencky.hpp>
+#include <parafsi/structure/relax.hpp>
+
+namespace st = parafsi::structure;
+using parafsi::index_t;
+
+namespace {
+
+/// Unit square, n×n quads, interior nodes perturbed by up to `jitter` cells.
+st::quad_mesh square_quads(int n, std::vector<Eigen::Vector3d>& X, double jitter, double zjitter = 0.0,
+                           unsigned seed = 7) {
+  std::mt19937 g(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  X.clear();
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      Eigen::Vector3d p{double(i) / n, double(j) / n, 0.0};
+      if (i > 0 && i < n && j > 0 && j < n) p += Eigen::Vector3d{jitter * u(g), jitter * u(g), 0.0} / n;
+      p.z() += zjitter * u(g) / n;
+      X.push_back(p);
+    }
+  st::quad_mesh m;
+  auto id = [&](int i, int j) { return index_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) m.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return m;
+}
+
+Eigen::Matrix3d rotation(double a, double b, double c) {
+  return (Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(b, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(c, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+/// A stand-alone quad membrane on a node set (no assembly), forces evaluated directly.
+template <class Fabric>
+struct rig {
+  st::nodes nd;
+  st::membrane_quad<Fabric> mem;
+  rig(const std::vector<Eigen::Vector3d>& X, st::quad_mesh m, Fabric f, st::quad_options o = {})
+      : mem(std::move(m), f, o) {
+    for (const auto& x : X) nd.add(x);
+    nd.materialize();
+    nd.reset_masses();
+    mem.finalize(nd);
+    nd.finalize_masses();
+  }
+  void place(const std::vector<Eigen::Vector3d>& x) {
+    for (std::size_t i = 0; i < x.size(); ++i) nd.set_position(index_t(i), x[i]);
+  }
+  template <bool Vectorize = true>
+  std::vector<Eigen::Vector3d> forces() {
+    auto& s = nd.data();
+    for (index_t i = 0; i < nd.size(); ++i) s.get<st::field::fx>()[i] = s.get<st::field::fy>()[i] = s.get<st::field::fz>()[i] = 0;
+    mem.template compute_forces<false, Vectorize>(nd.kinematics());
+    mem.template scatter<false>(nd);
+    std::vector<Eigen::Vector3d> f;
+    for (index_t i = 0; i < nd.size(); ++i) f.push_back(nd.force(i));
+    return f;
+  }
+};
+
+using elastic = st::material::fabric<st::wrinkling::none>;
+
+}  // namespace
+
+TEST_CASE("membrane_quad patch test: a uniform strain is reproduced exactly on a distorted mesh") {
+  std::vector<Eigen::Vector3d> X;
+  auto mesh = square_quads(6, X, 0.3);
+  const double warp_angle = 0.5236;  // 30°
+  mesh.warp = {std::cos(warp_angle), std::sin(warp_angle), 0.0};
+  rig r(X, mesh, elastic{2e9, 1e9, 0.3, 0.4e9, 0.1, 1e-4}, st::quad_options{0.0, 0.05, 0.1, 0.0});
+  Eigen::Matrix3d F0 = Eigen::Matrix3d::Identity();
+  F0(0, 0) = 1.02; F0(0, 1) = 0.013; F0(1, 0) = 0.004; F0(1, 1) = 0.985;
+  const Eigen::Matrix3d R = rotation(0.7, -0.4, 1.1);
+  std::vector<Eigen::Vector3d> x;
+  for (const auto& p : X) x.push_back(R * (F0 * p) + Eigen::Vector3d{0.3, -2.0, 5.0});
+  r.place(x);
+  const Eigen::Matrix3d Eg = 0.5 * (F0.transpose() * F0 - Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d e1{std::cos(warp_angle), std::sin(warp_angle), 0}, e2{-std::sin(warp_angle), std::cos(warp_angle), 0};
+  const double E11 = e1.dot(Eg * e1), E22 = e2.dot(Eg * e2), E12x2 = 2 * e1.dot(Eg * e2);
+  double err = 0, hg = 0;
+  for (index_t e = 0; e < r.mem.size(); ++e) {
+    const auto ss = r.mem.strain_stress(r.nd, e);
+    err = std::max({err, std::abs(ss[0] - E11), std::abs(ss[1] - E22), std::abs(ss[2] - E12x2)});
+    hg = std::max(hg, r.mem.hourglass_mode(r.nd, e).norm());
+  }
+  std::printf("quad patch test: max strain error %.3e (strain ~ %.3e), max hourglass displacement %.3e m\n", err,
+              std::abs(E11), hg);
+  CHECK(err < 1e-13);
+  CHECK(hg < 1e-14);
+  const auto f = r.forces();
+  double fmax = 0, finterior = 0;
+  for (int j = 0; j <= 6; ++j)
+    for (int i = 0; i <= 6; ++i) {
+      const double m = f[std::size_t(j * 7 + i)].norm();
+      fmax = std::max(fmax, m);
+      if (i > 0 && i < 6 && j > 0 && j < 6) finterior = std::max(finterior, m);
+    }
+  std::printf("quad patch test: max interior residual %.3e of max boundary force %.3e\n", finterior, fmax);
+  CHECK(fmax > 1.0);
+  CHECK(finterior < 1e-10 * fmax);
+}
+
+TEST_CASE("membrane_quad objectivity: a rigid rotation creates no strain and no force (flat and warped reference)") {
+  for (double zj : {0.0, 0.05}) {
+    std::vector<Eigen::Vector3d> X;
+    auto mesh = square_quads(4, X, 0.2, zj);
+    rig r(X, mesh, elastic::isotropic(1e9, 0.3, 0.05, 1e-4), st::quad_options{0.0, 0.05, 0.1, 0.0});
+    const Eigen::Matrix3d R = rotation(1.3, 0.9, -2.2);
+    std::vector<Eigen::Vector3d> x;
+    for (const auto& p : X) x.push_back(R * p + Eigen::Vector3d{1, 2, 3});
+    r.place(x);
+    double smax = 0, hg = 0;
+    for (index_t e = 0; e < r.mem.size(); ++e) {
+      const auto ss = r.mem.strain_stress(r.nd, e);
+      for (int k = 0; k < 6; ++k) smax = std::max(smax, std::abs(ss[std::size_t(k)]) / (k < 3 ? 1.0 : 1e9));
+      hg = std::max(hg, r.mem.hourglass_mode(r.nd, e).norm());
+    }
+    const auto f = r.forces();
+    double fmax = 0;
+    for (const auto& v : f) fmax = std::max(fmax, v.norm());
+    std::printf("quad rigid rotation (reference warp %.2f cell): max |E| %.3e, hourglass %.3e m, max |f| %.3e N\n", zj,
+                smax, hg, fmax);
+    CHECK(smax < 1e-14);
+    CHECK(hg < 1e-14);
+    CHECK(fmax < 1e-8);
+  }
+}
+
+TEST_CASE("membrane_quad: orthotropic law reproduces the warp, weft, shear and bias moduli") {
+  const double E1 = 2.0e9, E2 = 0.8e9, nu12 = 0.25, G12 = 0.15e9;
+  const auto fab = elastic{E1, E2, nu12, G12, 0.05, 1e-4};
+  std::vector<Eigen::Vector3d> X{{0, 0, 0}, {1, 0.1, 0}, {1.1, 0.9, 0}, {-0.1, 0.8, 0}};
+  st::quad_mesh m;
+  m.quads = {{0, 1, 2, 3}};
+  const double th = 0.6;
+  m.warp = {std::cos(th), std::sin(th), 0};
+  rig r(X, m, fab);
+  const Eigen::Vector3d e1{std::cos(th), std::sin(th), 0}, e2{-std::sin(th), std::cos(th), 0};
+  const Eigen::Matrix3d Rg = rotation(0.3, 0.2, 0.1);
+  auto impose = [&](double a11, double a22, double a12) {
+    Eigen::Matrix3d Ef = a11 * e1 * e1.transpose() + a22 * e2 * e2.transpose() +
+                         a12 * (e1 * e2.transpose() + e2 * e1.transpose());
+    const Eigen::Matrix3d U =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Eigen::Matrix3d::Identity() + 2 * Ef).operatorSqrt();
+    std::vector<Eigen::Vector3d> x;
+    for (const auto& p : X) x.push_back(Rg * U * p);
+    r.place(x);
+    return r.mem.strain_stress(r.nd, 0);
+  };
+  const double eps = 1e-3;
+  auto s = impose(eps, -nu12 * eps, 0);
+  const double warp = s[3] / s[0];
+  CHECK(warp == doctest::Approx(E1).epsilon(1e-9));
+  CHECK(std::abs(s[4]) < 1e-9 * std::abs(s[3]));
+  s = impose(-nu12 * E2 / E1 * eps, eps, 0);
+  const double weft = s[4] / s[1];
+  CHECK(weft == doctest::Approx(E2).epsilon(1e-9));
+  CHECK(std::abs(s[3]) < 1e-9 * std::abs(s[4]));
+  s = impose(0, 0, eps);
+  CHECK(s[5] / s[2] == doctest::Approx(G12).epsilon(1e-9));
+  const double sig = 1e5, c2 = 0.5;
+  const double e11 = sig * (c2 / E1 - nu12 / E1 * c2), e22 = sig * (c2 / E2 - nu12 / E1 * c2), g12 = sig * c2 / G12;
+  s = impose(e11, e22, 0.5 * g12);
+  const double Sn = 0.5 * (s[3] + s[4]) + s[5];
+  const double En = 0.5 * (s[0] + s[1]) + 0.5 * s[2];
+  const double E45 = 4.0 / (1 / E1 + 1 / E2 + 1 / G12 - 2 * nu12 / E1);
+  std::printf("quad moduli: warp %.6e (E1 %.6e) weft %.6e (E2 %.6e) bias %.6e (closed form %.6e)\n", warp, E1, weft, E2,
+              Sn / En, E45);
+  CHECK(Sn == doctest::Approx(sig).epsilon(1e-6));
+  CHECK(Sn / En == doctest::Approx(E45).epsilon(1e-6));
+}
+
+TEST_CASE("membrane_quad hourglass control: a single element loaded in its hourglass mode does not collapse") {
+  // Unit square, self-equilibrated nodal loads F h_I e_x (h = (1,−1,1,−1)): the one-point
+  // strain is blind to this mode; only the hourglass spring resists, δ = F/(4 k_hg).
+  std::vector<Eigen::Vector3d> X{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  st::quad_mesh m;
+  m.quads = {{0, 1, 2, 3}};
+  const double F = 2.0, h[4] = {1, -1, 1, -1};
+  double omega = 0;  // of the controlled mode, √(4 k_hg / m); the same damping and time for both runs
+  auto run = [&](double r_hg, double& delta, double& k) {
+    st::nodes nd;
+    for (const auto& x : X) nd.add(x);
+    st::assembly s{std::move(nd), st::membrane_quad{m, elastic::isotropic(1e9, 0.3, 0.05, 1e-4),
+                                                    st::quad_options{0.0, 0.05, r_hg, 0.0}}};
+    s.integrator().gravity.setZero();
+    s.finalize();
+    k = s.part<0>().hourglass_spring(0);
+    const double m_node = s.node_set().mass(0);
+    if (omega == 0) omega = std::sqrt(4 * k / m_node);
+    s.integrator().mass_damping = 2 * omega;
+    auto load = [&](st::load_sink& sink, double) {
+      for (int a = 0; a < 4; ++a) sink.add(a, Eigen::Vector3d{F * h[a], 0, 0});
+    };
+    const double dt = s.stable_dt();
+    while (s.time() < 40 / omega) s.step(dt, load);
+    delta = 0;
+    for (int a = 0; a < 4; ++a) delta += 0.25 * h[a] * (s.node_set().position(a).x() - X[std::size_t(a)].x());
+  };
+  double d1, k1, d0, k0;
+  run(0.05, d1, k1);
+  run(0.0, d0, k0);
+  const double d_exact = F / (4 * k1);
+  std::printf("hourglass load: r_hg = 0.05: delta %.6e m (F/(4k) = %.6e m, k_hg = %.4e N/m); r_hg = 0: delta %.3e m "
+              "after the same time\n", d1, d_exact, k1, d0);
+  CHECK(d1 == doctest::Approx(d_exact).epsilon(0.01));
+  CHECK(std::abs(d1) < 1e-3);             // bounded, far below the element size
+  // Uncontrolled: the mode drifts at the terminal speed F/(m α), δ ≈ 20 F/(4 k_hg) by then
+  // and growing linearly in time.
+  CHECK(std::abs(d0) > 10 * std::abs(d1));
+}
+
+TEST_CASE("membrane_quad: degenerate and inverted quads are rejected at set-up with their id") {
+  auto message = [](std::vector<Eigen::Vector3d> X, std::vector<std::array<index_t, 4>> q) {
+    st::nodes nd;
+    for (const auto& x : X) nd.add(x);
+    st::quad_mesh m;
+    m.quads = q;
+    st::assembly s{std::move(nd), st::membrane_quad{m, st::material::fabric<>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
+    std::string msg;
+    try { s.finalize(); } catch (const parafsi::invalid_input& e) { msg = e.what(); }
+    return msg;
+  };
+  const std::vector<Eigen::Vector3d> good{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  auto with = [&](std::vector<Eigen::Vector3d> extra) {
+    auto X = good;
+    X.insert(X.end(), extra.begin(), extra.end());
+    return X;
+  };
+  // Element 1: re-entrant (arrowhead) quad.
+  std::string a = message(with({{2, 0, 0}, {3, 0, 0}, {2.2, 0.2, 0}, {2, 1, 0}}), {{0, 1, 2, 3}, {4, 5, 6, 7}});
+  // Element 1: self-intersecting (bow-tie) quad.
+  std::string b = message(with({{2, 0, 0}, {3, 0, 0}, {2, 1, 0}, {3, 1, 0}}), {{0, 1, 2, 3}, {4, 5, 6, 7}});
+  // Element 2: repeated node (collapsed to a triangle).
+  std::string c = message(good, {{0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 2}});
+  // Element 1: all corners on a line (zero area).
+  std::string d = message(with({{2, 0, 0}, {3, 0, 0}, {4, 0, 0}, {5, 0, 0}}), {{0, 1, 2, 3}, {4, 5, 6, 7}});
+  // Element 0: nearly collapsed corner (a sliver quad).
+  std::string e = message({{0, 0, 0}, {1, 0, 0}, {1, 1e-3, 0}, {0, 1e-3, 0}}, {{0, 1, 2, 3}});
+  std::printf("rejections:\n  %s\n  %s\n  %s\n  %s\n", a.c_str(), b.c_str(), c.c_str(), d.c_str());
+  CHECK(a.find("element 1") != std::string::npos);
+  CHECK(a.find("inverted") != std::string::npos);
+  CHECK(b.find("element 1") != std::string::npos);
+  CHECK(c.find("element 2") != std::string::npos);
+  CHECK(c.find("repeats") != std::string::npos);
+  CHECK(d.find("element 1") != std::string::npos);
+  // A thin but regular rectangle is a valid element (all corners 90°).
+  CHECK(e.empty());
+}
+
+TEST_CASE("membrane_quad: critical step is below 2/omega_max of the element and not far below") {
+  // Exact ω_max of one free element: eigenvalues of M^{-1/2} K M^{-1/2}, K by central
+  // differences of the corner forces at the (stress-free) reference.
+  const auto fab = elastic{2e9, 1e9, 0.3, 0.5e9, 0.05, 1e-4};
+  const std::vector<std::vector<Eigen::Vector3d>> shapes{
+      {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},
+      {{0, 0, 0}, {3, 0, 0}, {3, 1, 0}, {0, 1, 0}},
+      {{0, 0, 0}, {1.2, 0.1, 0}, {0.9, 0.8, 0}, {-0.2, 1.1, 0}},
+      {{0, 0, 0}, {1, 0, 0}, {1.8, 1, 0}, {0.8, 1, 0}},  // parallelogram, 51° corner
+      {{0, 0, 0}, {1, 0, 0}, {0.7, 0.5, 0}, {0.3, 0.5, 0}},  // trapezoid
+  };
+  for (double r_hg : {0.05, 0.1})
+    for (const auto& X : shapes) {
+      st::quad_mesh m;
+      m.quads = {{0, 1, 2, 3}};
+      rig r(X, m, fab, st::quad_options{0.0, 0.05, r_hg, 0.0});
+      Eigen::Matrix<double, 12, 12> K;
+      const double h = 1e-7;
+      for (int j = 0; j < 12; ++j) {
+        auto xp = X, xm = X;
+        xp[std::size_t(j / 3)](j % 3) += h;
+        xm[std::size_t(j / 3)](j % 3) -= h;
+        r.place(xp);
+        const auto fp = r.forces();
+        r.place(xm);
+        const auto fm = r.forces();
+        for (int i = 0; i < 12; ++i) K(i, j) = -(fp[std::size_t(i / 3)](i % 3) - fm[std::size_t(i / 3)](i % 3)) / (2 * h);
+      }
+      r.place(X);
+      Eigen::Matrix<double, 12, 12> A = 0.5 * (K + K.transpose());
+      for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) A(i, j) /= std::sqrt(r.nd.mass(i / 3) * r.nd.mass(j / 3));
+      const double w2 = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>>(A).eigenvalues().maxCoeff();
+      const double exact = 2 / std::sqrt(w2), dt = r.mem.critical_dt(r.nd);
+      std::printf("quad dt: r_hg %.2f shape %zu: critical_dt %.4e s, 2/omega_max %.4e s, ratio %.3f\n", r_hg,
+                  std::size_t(&X - shapes.data()), dt, exact, dt / exact);
+      CHECK(dt <= exact);
+      CHECK(dt >= 0.4 * exact);
+    }
+}
+
+TEST_CASE("membrane_quad: SIMD and scalar kernels agree; results do not depend on thread count") {
+  const auto d = parafsi::model::disk_quad_mesh(1.0, 12);
+  st::quad_mesh m;
+  m.quads = d.quads;
+  std::mt19937 g(11);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
+  std::vector<Eigen::Vector3d> x;
+  for (const auto& p : d.positions) x.push_back(1.01 * p + Eigen::Vector3d{u(g), u(g), u(g)});
+  rig r(d.positions, m, st::material::fabric<>{2e9, 1e9, 0.3, 0.3e9, 0.05, 1e-4}, st::quad_options{0.05, 0.05, 0.1, 0.1});
+  r.mem.set_pressure(100.0);
+  r.place(x);
+  for (std::size_t i = 0; i < x.size(); ++i) r.nd.set_velocity(index_t(i), Eigen::Vector3d{u(g), u(g), u(g)} * 100.0);
+  const auto fv = r.forces<true>();
+  const auto fs = r.forces<false>();
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < fv.size(); ++i) { diff = std::max(diff, (fv[i] - fs[i]).norm()); scale = std::max(scale, fs[i].norm()); }
+  std::printf("quad SIMD (width %zu) vs scalar: max diff %.3e of %.3e\n", parafsi::simd::width, diff, scale);
+  CHECK(scale > 0);
+  CHECK(diff <= 1e-12 * scale);
+  if (parafsi::parallel::enabled()) {
+    parafsi::parallel::set_threads(1);
+    const auto f1 = r.forces<true>();
+    parafsi::parallel::set_threads(2);
+    const auto f2 = r.forces<true>();
+    bool same = true;
+    for (std::size_t i = 0; i < f1.size(); ++i) same = same && f1[i] == f2[i];
+    CHECK(same);
+    parafsi::parallel::set_threads(1);
+  }
+}
+
+TEST_CASE("membrane_quad: energy ledger balances for an undamped pressurised sheet") {
+  // Clamped square sheet, sudden pressure, no damping: K + U − W stays constant.
+  std::vector<Eigen::Vector3d> X;
+  auto mesh = square_quads(8, X, 0.2);
+  st::nodes nd;
+  for (const auto& p : X) nd.add(p);
+  for (int j = 0; j <= 8; ++j)
+    for (int i = 0; i <= 8; ++i)
+      if (i == 0 || j == 0 || i == 8 || j == 8) nd.pin(index_t(j * 9 + i));
+  st::assembly s{std::move(nd), st::membrane_quad{mesh, st::material::fabric<st::wrinkling::none>::isotropic(
+                                                            1e9, 0.3, 0.05, 1e-4)}};
+  s.part<0>().set_pressure(50.0);
+  s.integrator().gravity.setZero();
+  s.track_energy();
+  const double dt = s.stable_dt();
+  double wmax = 0;
+  while (s.time() < 0.02) {
+    s.step(dt);
+    wmax = std::max(wmax, s.energy().external);
+  }
+  const auto& E = s.energy();
+  std::printf("quad energy: K %.4e U %.4e (hourglass %.3e) W %.4e, balance %.3e J (%.2e of max W)\n", E.kinetic,
+              E.strain, s.part<0>().hourglass_energy(), E.external, E.balance(), E.balance() / wmax);
+  CHECK(wmax > 0);
+  CHECK(std::abs(E.balance()) < 0.01 * wmax);
+}
+
+namespace {
+struct hencky_case {
+  double a = 0.5, h = 1e-4, E = 1e9, nu = 0.3, p = 40.0;
+  double w_ref() const { return st::reference::hencky(nu).coefficient * a * std::cbrt(p * a / (E * h)); }
+  double omega1() const {
+    const double sigma = st::reference::hencky(nu).s0 * std::cbrt(E * p * p * a * a / (8 * h * h));
+    return 2.405 * std::sqrt(sigma / 1000.0) / a;
+  }
+  template <class Asm>
+  void relax(Asm& s) const {
+    s.integrator().gravity.setZero();
+    s.integrator().mass_damping = 2 * omega1();
+    st::relax_options ro;
+    ro.tolerance = 1e-14;
+    ro.t_min = 6.3 / omega1();
+    ro.t_max = 400 / omega1();
+    REQUIRE(st::relax(s, ro).converged);
+  }
+  auto fabric() const { return st::material::fabric<>::isotropic(E, nu, 1000 * h, h); }
+};
+}  // namespace
+
+TEST_CASE("clamped circular membrane: quad and triangle agree with each other and with Föppl–Hencky") {
+  parafsi::parallel::set_threads(1);
+  const hencky_case hc;
+  // Triangles: 6 N² CST, N = 16 (1536 elements, 817 nodes).
+  double w_tri;
+  {
+    const auto d = parafsi::model::disk_mesh(hc.a, 16);
+    st::nodes nd;
+    for (const auto& x : d.positions) nd.add(x);
+    for (auto i : d.rim) nd.pin(i);
+    st::triangle_mesh m;
+    m.triangles = d.triangles;
+    st::membrane_tri mem{m, hc.fabric()};
+    mem.set_pressure(hc.p);
+    st::assembly s{std::move(nd), std::move(mem)};
+    hc.relax(s);
+    w_tri = s.node_set().position(0).z();
+  }
+  // Quads: O-grid, n = 20 (400 + 80·10 = 1200 elements, 1241 nodes).
+  auto quad_run = [&](int n, double r_hg, double& hg_share) {
+    const auto d = parafsi::model::disk_quad_mesh(hc.a, n);
+    st::nodes nd;
+    for (const auto& x : d.positions) nd.add(x);
+    for (auto i : d.rim) nd.pin(i);
+    st::quad_mesh m;
+    m.quads = d.quads;
+    st::membrane_quad mem{m, hc.fabric(), st::quad_options{0.0, 0.05, r_hg, 0.0}};
+    mem.set_pressure(hc.p);
+    st::assembly s{std::move(nd), std::move(mem)};
+    hc.relax(s);
+    const double U = s.evaluate_forces();
+    hg_share = s.part<0>().hourglass_energy() / U;
+    std::printf("Hencky quad n = %d (%zu quads, r_hg %.2f): w0 = %.8e m, hourglass energy %.3e J of strain %.3e J\n", n,
+                d.quads.size(), r_hg, s.node_set().position(d.centre).z(), s.part<0>().hourglass_energy(), U);
+    return s.node_set().position(d.centre).z();
+  };
+  double share05, share10, share_coarse;
+  const double w_quad = quad_run(20, 0.05, share05);
+  const double w_quad10 = quad_run(20, 0.10, share10);
+  const double w_coarse = quad_run(10, 0.05, share_coarse);
+  const double w_ref = hc.w_ref();
+  std::printf("Hencky: w_ref %.8e  tri (N=16) %.8e (%+.3e)  quad (n=20) %.8e (%+.3e), quad vs tri %+.3e; "
+              "r_hg 0.1: %+.3e vs ref; quad n=10: %+.3e vs ref\n", w_ref, w_tri, w_tri / w_ref - 1, w_quad,
+              w_quad / w_ref - 1, w_quad / w_tri - 1, w_quad10 / w_ref - 1, w_coarse / w_ref - 1);
+  std::printf("Hencky: hourglass share of strain energy %.3e (r_hg 0.05), %.3e (r_hg 0.1), %.3e (n = 10)\n", share05,
+              share10, share_coarse);
+  CHECK(std::abs(w_quad / w_tri - 1) < 0.02);
+  CHECK(std::abs(w_quad / w_ref - 1) < 0.02);
+  CHECK(std::abs(w_tri / w_ref - 1) < 0.02);
+  CHECK(std::abs(w_quad10 / w_ref - 1) < 0.02);
+  CHECK(std::abs(w_quad / w_ref - 1) < 0.003);  // in fact much closer
+  CHECK(std::abs(w_quad10 / w_quad - 1) < 1e-4);  // insensitive to r_hg
+  CHECK(share05 < 1e-3);
+  CHECK(share10 < 1e-3);
+  CHECK(share_coarse < 1e-3);
+}

@@ -113,3 +113,10 @@ foreach(f IN ITEMS hllc rusanov ausm_plus_up)
 endforeach()
 parafsi_example_fails(example_moving_box_detects_failure moving_box --cells 8 --steps 50 --tolerance 1e-300)
 parafsi_example_fails(example_moving_box_bad_steps moving_box --steps 0)
+# ---- inflated_membrane: both membrane elements on a coarse disk (N = 6 → 7 radii).
+parafsi_example_csv_test(example_inflated_membrane_tri inflated_membrane "r,w" 7 "centre_deflection="
+  --radius 0.5 --thickness 1e-4 --E 1e9 --nu 0.3 --pressure 40 --elements 6)
+parafsi_example_csv_test(example_inflated_membrane_quad inflated_membrane "r,w" 7 "centre_deflection="
+  --radius 0.5 --thickness 1e-4 --E 1e9 --nu 0.3 --pressure 40 --elements 6 --element quad)
+parafsi_example_fails(example_inflated_membrane_bad_element inflated_membrane --radius 0.5 --thickness 1e-4
+  --E 1e9 --nu 0.3 --pressure 40 --element hex --out ${_ex_out}/unused.csv)

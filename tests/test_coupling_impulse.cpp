@@ -68,6 +68,7 @@ void check_balance(S& s, int steps, const char* label) {
 }  // namespace
 
 TEST_CASE("penalty: impulse balance to round-off every step (impermeable, one substep)") {
+  pf::parallel::set_threads(1);
   auto s = make_stepper(pf::porosity::impermeable{}, 0.5, 1e5, 0.1);
   check_balance(s, 40, "impermeable");
   CHECK(s.coupling().points().size() > 0);

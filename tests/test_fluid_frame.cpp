@@ -100,3 +100,18 @@ TEST_CASE("follow_payload frame: tracks the target and aligns its axis with the 
   const double eq1 = vel.cross(acc).norm() / vel.squaredNorm();
   CHECK(s.pose().Omega.norm() == doctest::Approx(eq1).epsilon(0.01));
 }
+
+TEST_CASE("a rotating box ends each step at the same pose with SSP-RK2 and SSP-RK3") {
+  auto grid = fluid::rectilinear_grid::uniform({4, 4, 4}, {-1, -1, -1}, {1, 1, 1});
+  frame::rigid motion{Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(0.0, 0.0, 1.0)};
+  fluid::solver a{grid, boundary::set::all(boundary::far_field{}), motion, time::ssp_rk2{}};
+  fluid::solver b{grid, boundary::set::all(boundary::far_field{}), motion, time::ssp_rk3{}};
+  for (int n = 0; n < 100; ++n) {
+    a.step(1e-4);
+    b.step(1e-4);
+  }
+  const Eigen::Matrix3d R_exact = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  CHECK((a.pose().R - R_exact).norm() < 1e-13);
+  CHECK((b.pose().R - R_exact).norm() < 1e-13);
+  CHECK((b.pose().X - Eigen::Vector3d(1, 2, 3) * 0.01).norm() < 1e-13);
+}

@@ -38,11 +38,12 @@ inline constexpr bool enabled() noexcept {
 }
 
 /// for i in [begin, end): f(i), iterations split statically over threads.
-/// Use only when iterations write disjoint data.
+/// Use only when iterations write disjoint data. `threaded = false` runs serially
+/// (small problems: a parallel region costs more than it saves).
 template <class F>
-inline void for_range(index_t begin, index_t end, F&& f) {
+inline void for_range(index_t begin, index_t end, F&& f, bool threaded = true) {
 #if defined(_OPENMP)
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (threaded)
   for (index_t i = begin; i < end; ++i) f(i);
 #else
   for (index_t i = begin; i < end; ++i) f(i);
@@ -52,9 +53,9 @@ inline void for_range(index_t begin, index_t end, F&& f) {
 /// Deterministic reduction: each index contributes f(i) to a per-index slot and the
 /// slots are combined in index order, so the result does not depend on threads.
 template <class T, class F, class Op>
-inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op) {
+inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op, bool threaded = true) {
   std::vector<T> part(static_cast<std::size_t>(end > begin ? end - begin : 0), init);
-  for_range(begin, end, [&](index_t i) { part[static_cast<std::size_t>(i - begin)] = f(i); });
+  for_range(begin, end, [&](index_t i) { part[static_cast<std::size_t>(i - begin)] = f(i); }, threaded);
   T acc = init;
   for (const T& p : part) acc = op(acc, p);
   return acc;

@@ -166,6 +166,7 @@ class solver {
       }
     }
     setup_sponge();
+    threaded_ = grid_.interior_cells() >= 32768;
     // Ambient default state everywhere (ghosts and padding included).
     fill_uniform({1.18, {0.0, 0.0, 0.0}, 101325.0});
   }
@@ -203,7 +204,9 @@ class solver {
                 const Eigen::Vector3d xi{grid_.face(0, i) + grid_.width(0, i) * (a + 0.5) / n,
                                          grid_.face(1, j) + grid_.width(1, j) * (b + 0.5) / n,
                                          grid_.face(2, k) + grid_.width(2, k) * (c + 0.5) / n};
-                acc = acc + to_cons(f(xi), gas_);
+                const prim<double> w = f(xi);
+                validate_state(w, "initialize_averaged");
+                acc = acc + to_cons(w, gas_);
               }
           store_cons(U_, grid_.index(i, j, k), acc * (1.0 / double(n * n * n)));
         }
@@ -220,12 +223,15 @@ class solver {
   const rectilinear_grid& grid() const noexcept { return grid_; }
   double time() const noexcept { return t_; }
   long steps() const noexcept { return steps_; }
+  /// Use OpenMP threads in the step phases (default: on for grids of ≥ 32768 cells).
+  void set_threading(bool on) noexcept { threaded_ = on; }
+  bool threading() const noexcept { return threaded_; }
   const phase_times& timings() const noexcept { return times_; }
   void reset_timings() noexcept { times_ = {}; }
 
   /// Composed policy names, for logs.
   std::string name() const {
-    return std::string("fluid::solver<") + Flux::name() + ", muscl:" + Recon::name() + ", " +
+    return std::string("fluid::solver<") + Flux::name() + ", recon:" + Recon::name() + ", " +
            Turbulence::name() + ", " + Viscosity::name() + ", " + Frame::name() + ", " + Time::name() + ">";
   }
 
@@ -323,7 +329,7 @@ class solver {
       return lam;
     };
     const double lam = parallel::reduce(index_t(0), ny * nz, 0.0, row_max,
-                                        [](double a, double b) { return std::max(a, b); });
+                                        [](double a, double b) { return std::max(a, b); }, threaded_);
     require(std::isfinite(lam) && lam > 0.0, "fluid::solver::stable_dt: non-finite wave speed");
     return cfl / lam;
   }
@@ -359,6 +365,12 @@ class solver {
 
  private:
   // ------------------------------------------------------------------ helpers
+  /// Parallel loop over disjoint work; serial for small grids (below ~32k cells a
+  /// parallel region costs more than it saves, and far more on a loaded machine).
+  template <class F>
+  void par_for(index_t b, index_t e, F&& f) const {
+    parallel::for_range(b, e, std::forward<F>(f), threaded_);
+  }
   static PARAFSI_INLINE void store_cons(cons_storage& s, index_t c, const cons<double>& q) noexcept {
     s.template get<field::rho>()[c] = q.rho;
     s.template get<field::mx>()[c] = q.m.x;
@@ -371,11 +383,11 @@ class solver {
             {s.template get<field::mx>()[c], s.template get<field::my>()[c], s.template get<field::mz>()[c]},
             s.template get<field::E>()[c]};
   }
-  static void copy_state(cons_storage& dst, const cons_storage& src) {
+  void copy_state(cons_storage& dst, const cons_storage& src) const {
     for (std::size_t f = 0; f < cons_storage::field_count; ++f) {
       double* d = dst.data(f);
       const double* s = src.data(f);
-      parallel::for_range(0, src.size(), [&](index_t c) { d[c] = s[c]; });
+      par_for(0, src.size(), [&](index_t c) { d[c] = s[c]; });
     }
   }
   void validate_state(const prim<double>& w, const char* where) const {
@@ -437,7 +449,7 @@ class solver {
         const vec3<double> nout = geo.n[std::size_t(d)] * (hi ? 1.0 : -1.0);
         std::visit([&](const auto& cond) {
           using C = std::decay_t<decltype(cond)>;
-          parallel::for_range(rb.first, rb.second, [&](index_t q) {
+          par_for(rb.first, rb.second, [&](index_t q) {
             for (index_t pidx = ra.first; pidx < ra.second; ++pidx) {
               for (index_t g = 1; g <= ng; ++g) {
                 index_t ijk_g[3], ijk_m[3], ijk_a[3];
@@ -485,7 +497,7 @@ class solver {
     const index_t chunk = 4096;
     const index_t nchunks = (N + chunk - 1) / chunk;
     const gas::ideal g = gas_;
-    parallel::for_range(0, nchunks, [&](index_t ch) {
+    par_for(0, nchunks, [&](index_t ch) {
       const index_t b = ch * chunk, e = std::min(N, b + chunk);
       simd::for_each_pack(b, e, [&](auto tag, index_t c) {
         using V = typename decltype(tag)::type;
@@ -600,7 +612,7 @@ class solver {
     const double* x2 = grid_.centres(2);
     if constexpr (D == 0) {
       const double* idx = grid_.inv_widths(0);
-      parallel::for_range(0, ny * nz, [&](index_t r) {
+      par_for(0, ny * nz, [&](index_t r) {
         const index_t j = r % ny, k = r / ny;
         auto& fb = bufs[std::size_t(thread_id())].a;
         const index_t base = grid_.index(0, j, k);
@@ -628,7 +640,7 @@ class solver {
       const index_t nD = grid_.n(D), nT = grid_.n(T);
       const index_t s = grid_.stride(D);
       const double* idx = grid_.inv_widths(D);
-      parallel::for_range(0, nT, [&](index_t q) {
+      par_for(0, nT, [&](index_t q) {
         auto& rb = bufs[std::size_t(thread_id())];
         auto* cur = &rb.a;
         auto* prev = &rb.b;
@@ -688,7 +700,7 @@ class solver {
     const double cp = gas_.cp();
     // 1. Box-frame velocity and temperature on every cell (ghosts included).
     const index_t N = grid_.total_cells();
-    parallel::for_range(0, N, [&](index_t c) {
+    par_for(0, N, [&](index_t c) {
       const Eigen::Vector3d u = Rt * Eigen::Vector3d(Wu[0][c], Wu[1][c], Wu[2][c]);
       ub[0][c] = u[0];
       ub[1][c] = u[1];
@@ -698,7 +710,7 @@ class solver {
     // 2. Cell gradients (central differences) and transport coefficients on cells
     //    [−1, n] in every direction.
     const double* xcs[3] = {grid_.centres(0), grid_.centres(1), grid_.centres(2)};
-    parallel::for_range(-1, nz + 1, [&](index_t k) {
+    par_for(-1, nz + 1, [&](index_t k) {
       for (index_t j = -1; j < ny + 1; ++j)
         for (index_t i = -1; i < nx + 1; ++i) {
           const index_t c = grid_.index(i, j, k);
@@ -756,7 +768,7 @@ class solver {
       out[2] = ti[2];
       out[3] = work + kf * gT[d];
     };
-    parallel::for_range(0, nz, [&](index_t k) {
+    par_for(0, nz, [&](index_t k) {
       for (index_t j = 0; j < ny; ++j)
         for (index_t i = 0; i < nx; ++i) {
           const index_t c = grid_.index(i, j, k);
@@ -784,7 +796,12 @@ class solver {
     sponge_.emplace(grid_.total_cells(), 0.0);
     double* sig = sponge_->template get<field::sponge_sigma>();
     const index_t L = bc_.layer.cells;
-    const double cinf = 340.0;
+    double cinf = 340.0;
+    for (const auto& f : bc_.face)
+      if (auto* ff = std::get_if<boundary::far_field>(&f)) {
+        cinf = gas_.sound_speed(ff->rho, ff->p);
+        break;
+      }
     for (index_t k = 0; k < grid_.n(2); ++k)
       for (index_t j = 0; j < grid_.n(1); ++j)
         for (index_t i = 0; i < grid_.n(0); ++i) {
@@ -818,7 +835,7 @@ class solver {
     const index_t nx = grid_.n(0), ny = grid_.n(1), nz = grid_.n(2);
     const double tgt[5] = {sponge_target_.rho, sponge_target_.m.x, sponge_target_.m.y, sponge_target_.m.z,
                            sponge_target_.E};
-    parallel::for_range(0, ny * nz, [&](index_t r) {
+    par_for(0, ny * nz, [&](index_t r) {
       const index_t base = grid_.index(0, r % ny, r / ny);
       for (index_t i = 0; i < nx; ++i) {
         const index_t c = base + i;
@@ -852,7 +869,7 @@ class solver {
                              dU_.template get<field::E>()};
       std::vector<char> bad(std::size_t(ny * nz), 0);
       const gas::ideal g = gas_;
-      parallel::for_range(0, ny * nz, [&](index_t r) {
+      par_for(0, ny * nz, [&](index_t r) {
         const index_t base = grid_.index(0, r % ny, r / ny);
         bool row_bad = false;
         simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
@@ -912,6 +929,7 @@ class solver {
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   std::vector<row_buffers> bufs_;
   phase_times times_{};
+  bool threaded_ = true;
 };
 
 /// Deduction guide: the policy of each kind among the arguments, defaults otherwise.

@@ -396,9 +396,11 @@ class membrane_quad {
     // the current BLT normal ê3 ∥ n = (x2 − x0) × (x3 − x1) (n also carries the pressure).
     const vec3<V> F1 = x0 * b0 + x1 * b1 + x2 * b2 + x3 * b3;
     const vec3<V> F2 = x0 * c0 + x1 * c1 + x2 * c2 + x3 * c3;
-    const vec3<V> n = cross(x2 - x0, x3 - x1);
+    const vec3<V> d1 = x2 - x0, d2 = x3 - x1;
+    const vec3<V> n = cross(d1, d2);
     const V nn = simd::sqrt(dot(n, n));
-    const vec3<V> e3 = n * (V(1.0) / simd::max(nn, V(std::numeric_limits<double>::min())));
+    const V inn = V(1.0) / simd::max(nn, V(std::numeric_limits<double>::min()));
+    const vec3<V> e3 = n * inn;
     const vec3<V> qh = x0 * g0 + x1 * g1 + x2 * g2 + x3 * g3;
     const V qn = dot(qh, e3);
     const vec3<V> qi = qh - e3 * qn;                  // in-plane (membrane) hourglass
@@ -445,20 +447,27 @@ class membrane_quad {
     const vec3<V> P2 = (F1 * T12 + F2 * T22) * at;
     const V Qw = V(2.0) * at * dn * (T11 * Gb + T22 * Gc + V(2.0) * T12 * Gx);
     const vec3<V> QT = qi * km + e3 * Qw + Qd;
+    // Rotation of ê3: ∂(q·ê3)/∂x = ±d2 × w (corners 2, 0), ±w × d1 (corners 3, 1),
+    // w = q_m/|n|, so the in-plane spring ½k_m(|q|² − (q·ê3)²) and the w-mode strain give
+    // exact gradients (no energy pumping by a turning frame in crumpled, folded states).
+    const vec3<V> wq = qi * inn;
+    const vec3<V> r2 = cross(d2, wq), r3 = cross(wq, d1);
+    const V sn = Qw - km * qn;
     const vec3<V> fp = n * (simd::load<V>(p_.data() + e) * V(0.125));
-    store_corner<V>(f_, 0, e, fp - (P1 * b0 + P2 * c0 + QT * g0));
-    store_corner<V>(f_, 1, e, fp - (P1 * b1 + P2 * c1 + QT * g1));
-    store_corner<V>(f_, 2, e, fp - (P1 * b2 + P2 * c2 + QT * g2));
-    store_corner<V>(f_, 3, e, fp - (P1 * b3 + P2 * c3 + QT * g3));
+    store_corner<V>(f_, 0, e, fp - (P1 * b0 + P2 * c0 + QT * g0 - r2 * sn));
+    store_corner<V>(f_, 1, e, fp - (P1 * b1 + P2 * c1 + QT * g1 - r3 * sn));
+    store_corner<V>(f_, 2, e, fp - (P1 * b2 + P2 * c2 + QT * g2 + r2 * sn));
+    store_corner<V>(f_, 3, e, fp - (P1 * b3 + P2 * c3 + QT * g3 + r3 * sn));
     if constexpr (Track) {
       const vec3<V> Q1 = (F1 * D11 + F2 * D12) * at;
       const vec3<V> Q2 = (F1 * D12 + F2 * D22) * at;
-      const vec3<V> Qdt = e3 * (V(2.0) * at * dn * (D11 * Gb + D22 * Gc + V(2.0) * D12 * Gx)) + Qd;
+      const V Qwd = V(2.0) * at * dn * (D11 * Gb + D22 * Gc + V(2.0) * D12 * Gx);
+      const vec3<V> Qdt = e3 * Qwd + Qd;
       const vec3<V> zero{V(0.0), V(0.0), V(0.0)};
-      store_corner<V>(fd_, 0, e, zero - (Q1 * b0 + Q2 * c0 + Qdt * g0));
-      store_corner<V>(fd_, 1, e, zero - (Q1 * b1 + Q2 * c1 + Qdt * g1));
-      store_corner<V>(fd_, 2, e, zero - (Q1 * b2 + Q2 * c2 + Qdt * g2));
-      store_corner<V>(fd_, 3, e, zero - (Q1 * b3 + Q2 * c3 + Qdt * g3));
+      store_corner<V>(fd_, 0, e, zero - (Q1 * b0 + Q2 * c0 + Qdt * g0 - r2 * Qwd));
+      store_corner<V>(fd_, 1, e, zero - (Q1 * b1 + Q2 * c1 + Qdt * g1 - r3 * Qwd));
+      store_corner<V>(fd_, 2, e, zero - (Q1 * b2 + Q2 * c2 + Qdt * g2 + r2 * Qwd));
+      store_corner<V>(fd_, 3, e, zero - (Q1 * b3 + Q2 * c3 + Qdt * g3 + r3 * Qwd));
       for (index_t c = 0; c < 4; ++c) store_corner<V>(fe_, c, e, fp);
       hg = V(0.5) * (km * dot(qi, qi) + at * dn2 * (S11 * Gb + S22 * Gc + V(2.0) * S12 * Gx));
       return V(0.5) * at * (S11 * E11 + S22 * E22 + V(2.0) * S12 * E12) + V(0.5) * km * dot(qi, qi);

@@ -24,8 +24,8 @@ struct pose {
 
   void advance(double dt) {
     X += V * dt;
-    const double a = Omega.norm() * dt;
-    if (a > 0.0) {
+    const double a = Omega.norm() * dt;  // signed: dt < 0 turns back (SSP-RK3's stage 3)
+    if (a != 0.0) {
       R = Eigen::AngleAxisd(a, Omega.normalized()).toRotationMatrix() * R;
       // Keep R orthonormal to round-off over long runs.
       Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);

@@ -5,7 +5,7 @@
 /// with d_w the distance to the nearest body (a per-cell field the user or the
 /// coupling fills; +∞ where unknown), κ = 0.41, C_l ≈ 0.07 for wakes and shear layers
 /// and L_ref the body size (the canopy's nominal diameter). μ_t is capped at
-/// `max_ratio` × μ_ref for robustness.
+/// `mu_cap` (Pa s; 1000 × air's viscosity by default) for robustness.
 /// References: Prandtl L. (1925) ZAMM 5:136; Wilcox D.C., Turbulence Modeling for CFD,
 ///   3rd ed., ch. 3; Pope S.B. (2000) Turbulent Flows, §10.3.
 #pragma once

@@ -22,10 +22,15 @@
 ///   f_I^int = −A0 t [F1 (S11 b_I + S12 c_I) + F2 (S12 b_I + S22 c_I)]   (S incl. S_v)
 /// Hourglass control (Flanagan & Belytschko 1981; BLT 1984), h = (1, −1, 1, −1):
 ///   γ_I = h_I − (h·X̂) b_I − (h·Ŷ) c_I      (γ ⟂ 1, X̂, Ŷ: linear fields carry none)
-///   q = Σ_I γ_I x_I,  q_n = q·ê3 − w0,  q_m = q − (q·ê3) ê3,  w0 = Σ_I γ_I Ẑ_I
+///   q = Σ_I γ_I x_I,  q_n = q·ê3 − w0,  w0 = Σ_I γ_I Ẑ_I
 ///   (ê3 ∥ (x2 − x0) × (x3 − x1); w0 the reference warp, 0 for a flat quad)
-///   in-plane (membrane) mode, elastic stiffness form (methods §5.2):
-///     k_m = r_hg Q_max t A0 Σ_I(b_I² + c_I²)/8,  r_hg = 0.05 default (0.05–0.1 usual)
+///   in-plane (membrane) mode, elastic stiffness form (methods §5.2) on the convected
+///   components a = Fᵀq (= the in-plane part of q in the BLT frame at small strain, since
+///   F_α·ê3 = 0 exactly):  U_m = ½ k_m |Fᵀq|²,
+///     k_m = r_hg Q_max t A0 Σ_I(b_I² + c_I²)/8,  r_hg = 0.05 default (0.05–0.1 usual).
+///     Measuring q in the convected tangents F1, F2 instead of a frame normalised by the
+///     current area keeps the spring well conditioned when elements are crumpled (a
+///     projection with ê3 = n/|n| made folded starts unstable at the nominal step).
 ///   out-of-plane (w) mode: a membrane has no elastic w stiffness (BLT's bending term
 ///     ∝ E t³/192 is negligible for fabric) but the fully integrated element stiffens
 ///     the bilinear w = δ ξη mode through the second-order strain ½∇w⊗∇w. Its element
@@ -36,11 +41,16 @@
 ///     and the energy stays the potential ½ A0 t S:E (conservative up to frozen ê3).
 ///   viscous form (FB): c_v = r_v · 2√(k_1 m_I)/|γ|, k_1 = k_m(r_hg = 1), m_I = ρ_A A0/4
 ///     (r_v = damping ratio of the mode against a unit-r spring; r_v = 0 default)
-///   Q_hg = k_m q_m + r_w A0 t q_n (T:G)/12 ê3 + β k_m q̇_m + c_v q̇,  q̇ = Σ_I γ_I v_I,
-///   T = S + S_v (S_v includes the rate of the w-mode strain),  f_I^hg = −γ_I Q_hg,
-///   U_hg = ½ k_m |q_m|² + ½ A0 t S:(r_w q_n² G/24)   (reported by hourglass_energy()).
-///   Every linear field x = R F0 X + c has q_m = 0 and q_n = 0: the patch test and rigid
-///   rotations are exact; forces are the gradient of the energy with ê3 frozen.
+///   Forces, with a = Fᵀq, q̇ = Σ_I γ_I v_I, T = S + S_v (S_v includes the w-mode rate),
+///   Q_w = r_w A0 t q_n (T:G)/12 and w = (q − (q·ê3)ê3)/|n|:
+///     f_I^hg = −γ_I [k_m F a + Q_w ê3 + β k_m F Fᵀq̇ + c_v q̇] − k_m q (a1 b_I + a2 c_I)
+///              ± Q_w (d2 × w) at corners 0/2, ± Q_w (w × d1) at corners 1/3
+///     (the last terms are the rotation of ê3, ∂(q·ê3)/∂x; d1 = x2 − x0, d2 = x3 − x1),
+///   so the elastic forces are the exact gradient of
+///     U = ½ A0 t S:E + ½ k_m |Fᵀq|²,   U_hg = ½ k_m |Fᵀq|² + ½ A0 t S:(r_w q_n² G/24)
+///   (U_hg is reported by hourglass_energy(), U by strain_energy()).
+///   Every linear field x = R F0 X + c has q = w0 ê3, i.e. Fᵀq = 0 and q_n = 0: the patch
+///   test and rigid rotations are exact.
 ///   f_I^p = (p/8) (x2 − x0) × (x3 − x1)   (p/4 of the quad's area vector per corner;
 ///          p > 0 pushes along n0's side; uniform or per element)
 ///   m_I  += ρ_A A0/4   (lumped, reference area)
@@ -403,7 +413,7 @@ class membrane_quad {
     const vec3<V> e3 = n * inn;
     const vec3<V> qh = x0 * g0 + x1 * g1 + x2 * g2 + x3 * g3;
     const V qn = dot(qh, e3);
-    const vec3<V> qi = qh - e3 * qn;                  // in-plane (membrane) hourglass
+    const V a1 = dot(F1, qh), a2 = dot(F2, qh);       // in-plane (membrane) hourglass, Fᵀq
     const V dn = qn - simd::load<V>(w0_.data() + e);  // out-of-plane (w) hourglass
     const V km = simd::load<V>(khg_.data() + e);
     const V Gb = simd::load<V>(gbb_.data() + e), Gx = simd::load<V>(gbc_.data() + e), Gc = simd::load<V>(gcc_.data() + e);
@@ -435,7 +445,7 @@ class membrane_quad {
       D11 = bt * (V(q_.Q11) * R11 + V(q_.Q12) * R22);
       D22 = bt * (V(q_.Q12) * R11 + V(q_.Q22) * R22);
       D12 = bt * V(2.0 * q_.Q66) * R12;
-      Qd = (qd - e3 * qdn) * (bt * km) + qd * simd::load<V>(cv_.data() + e);
+      Qd = (F1 * dot(F1, qd) + F2 * dot(F2, qd)) * (bt * km) + qd * simd::load<V>(cv_.data() + e);
     }
     // Step 5. Wrinkling (no compression).
     mat_.wrinkling.apply(S11, S22, S12, D11, D22, D12, E11, E22, E12, q_);
@@ -443,16 +453,16 @@ class membrane_quad {
     // Q_w = 2 A0 t q_n (T11 G11 + T22 G22 + 2 T12 G12)  (the w-mode term of ∂E/∂x).
     const V at = simd::load<V>(a0t_.data() + e);
     const V T11 = S11 + D11, T22 = S22 + D22, T12 = S12 + D12;
-    const vec3<V> P1 = (F1 * T11 + F2 * T12) * at;
-    const vec3<V> P2 = (F1 * T12 + F2 * T22) * at;
+    // In-plane spring ½k_m|Fᵀq|²: ∂/∂x_I = k_m [γ_I F Fᵀq + q (a1 b_I + a2 c_I)].
+    const vec3<V> P1 = (F1 * T11 + F2 * T12) * at + qh * (km * a1);
+    const vec3<V> P2 = (F1 * T12 + F2 * T22) * at + qh * (km * a2);
     const V Qw = V(2.0) * at * dn * (T11 * Gb + T22 * Gc + V(2.0) * T12 * Gx);
-    const vec3<V> QT = qi * km + e3 * Qw + Qd;
-    // Rotation of ê3: ∂(q·ê3)/∂x = ±d2 × w (corners 2, 0), ±w × d1 (corners 3, 1),
-    // w = q_m/|n|, so the in-plane spring ½k_m(|q|² − (q·ê3)²) and the w-mode strain give
-    // exact gradients (no energy pumping by a turning frame in crumpled, folded states).
-    const vec3<V> wq = qi * inn;
+    const vec3<V> QT = (F1 * a1 + F2 * a2) * km + e3 * Qw + Qd;
+    // Rotation of ê3 in the w-mode strain: ∂(q·ê3)/∂x = ±d2 × w (corners 2, 0), ±w × d1
+    // (corners 3, 1), w = (q − (q·ê3)ê3)/|n|: the forces are exact gradients.
+    const vec3<V> wq = (qh - e3 * qn) * inn;
     const vec3<V> r2 = cross(d2, wq), r3 = cross(wq, d1);
-    const V sn = Qw - km * qn;
+    const V sn = Qw;
     const vec3<V> fp = n * (simd::load<V>(p_.data() + e) * V(0.125));
     store_corner<V>(f_, 0, e, fp - (P1 * b0 + P2 * c0 + QT * g0 - r2 * sn));
     store_corner<V>(f_, 1, e, fp - (P1 * b1 + P2 * c1 + QT * g1 - r3 * sn));
@@ -469,8 +479,9 @@ class membrane_quad {
       store_corner<V>(fd_, 2, e, zero - (Q1 * b2 + Q2 * c2 + Qdt * g2 + r2 * Qwd));
       store_corner<V>(fd_, 3, e, zero - (Q1 * b3 + Q2 * c3 + Qdt * g3 + r3 * Qwd));
       for (index_t c = 0; c < 4; ++c) store_corner<V>(fe_, c, e, fp);
-      hg = V(0.5) * (km * dot(qi, qi) + at * dn2 * (S11 * Gb + S22 * Gc + V(2.0) * S12 * Gx));
-      return V(0.5) * at * (S11 * E11 + S22 * E22 + V(2.0) * S12 * E12) + V(0.5) * km * dot(qi, qi);
+      const V um = V(0.5) * km * (a1 * a1 + a2 * a2);
+      hg = um + V(0.5) * at * dn2 * (S11 * Gb + S22 * Gc + V(2.0) * S12 * Gx);
+      return V(0.5) * at * (S11 * E11 + S22 * E22 + V(2.0) * S12 * E12) + um;
     } else {
       return V(0.0);
     }

@@ -1,4 +1,5 @@
 // Belytschko–Tsay one-point quad membrane: patch test, objectivity, orthotropic moduli,
+// exact energy gradient, folded start,
 // hourglass control, set-up rejection, critical step vs the exact element frequency,
 // scalar ≡ SIMD and thread independence, energy balance, and agreement with the CST
 // triangle and Föppl–Hencky on the clamped circular membrane.

@@ -49,8 +49,8 @@
 ///   so the elastic forces are the exact gradient of
 ///     U = ½ A0 t S:E + ½ k_m |Fᵀq|²,   U_hg = ½ k_m |Fᵀq|² + ½ A0 t S:(r_w q_n² G/24)
 ///   (U_hg is reported by hourglass_energy(), U by strain_energy()).
-///   Every linear field x = R F0 X + c has q = w0 ê3, i.e. Fᵀq = 0 and q_n = 0: the patch
-///   test and rigid rotations are exact.
+///   For a flat reference every linear field x = R F0 X + c has q = 0: the patch test is
+///   exact; for a warped one a rigid motion gives q = w0 ê3 (Fᵀq = 0, q_n = 0).
 ///   f_I^p = (p/8) (x2 − x0) × (x3 − x1)   (p/4 of the quad's area vector per corner;
 ///          p > 0 pushes along n0's side; uniform or per element)
 ///   m_I  += ρ_A A0/4   (lumped, reference area)

@@ -514,20 +514,20 @@ class solver {
     });
   }
 
-  /// Thread-local row buffers for the flux sweeps.
+  /// Thread-local row buffers for the flux sweeps: face values of a row of cells
+  /// (lo: at the cell's low face, hi: at its high face; hi of the previous row for
+  /// the y/z sweeps) and two rolling rows of face fluxes.
   struct row_buffers {
-    std::array<simd::aligned_vector<double>, 5> a, b;
+    std::array<simd::aligned_vector<double>, 5> lo, hi, hi_prev, fa, fb;
   };
   std::vector<row_buffers>& buffers() {
     const std::size_t nt = std::size_t(parallel::max_threads());
-    const std::size_t len = std::size_t(grid_.n(0)) + 2 * simd::width + 2;
-    if (bufs_.size() < nt || (bufs_.size() && bufs_[0].a[0].size() < len)) {
+    const std::size_t len = std::size_t(grid_.n(0)) + 2 * simd::width + 4;
+    if (bufs_.size() < nt || (bufs_.size() && bufs_[0].lo[0].size() < len)) {
       bufs_.assign(nt, {});
       for (auto& rb : bufs_)
-        for (int f = 0; f < 5; ++f) {
-          rb.a[std::size_t(f)].assign(len, 0.0);
-          rb.b[std::size_t(f)].assign(len, 0.0);
-        }
+        for (auto* arr : {&rb.lo, &rb.hi, &rb.hi_prev, &rb.fa, &rb.fb})
+          for (auto& v : *arr) v.assign(len, 0.0);
     }
     return bufs_;
   }
@@ -539,67 +539,82 @@ class solver {
 #endif
   }
 
-  /// Reconstructed face states and the ALE Riemann flux at the face between cells
-  /// m = c − s and c along axis D, for the lanes starting at c. `ia` is the axis
-  /// index of cell c (lanes along x when D = 0, otherwise a scalar broadcast).
+  /// MUSCL face values of the cells starting at c (lanes along x) along axis D:
+  /// W_c ∓ (Δx_c/2)·limiter(a, b) with per-unit-length gradients a, b. Each cell's
+  /// slope is computed once per sweep. Where a face value would have ρ ≤ 0 or p ≤ 0,
+  /// the cell falls back to first order (both faces take the cell value).
   template <int D, class V>
-  PARAFSI_INLINE cons<V> face_flux(index_t c, index_t s, index_t ia, const V& wn,
-                                   const vec3<double>& n) const noexcept {
+  PARAFSI_INLINE void cell_faces(index_t c, index_t s, index_t ia, double* const* lo, double* const* hi,
+                                 index_t o) const noexcept {
     const double* W[5] = {W_.template get<field::rho>(), W_.template get<field::u>(), W_.template get<field::v>(),
                           W_.template get<field::w>(), W_.template get<field::p>()};
-    V wl[5], wr[5];
     if constexpr (Recon::second_order) {
       const double* idc = grid_.inv_centre_gaps(D);
       const double* hdx = grid_.half_widths(D);
-      V idc_m, idc_c, idc_p, h_m, h_c;
+      V idc_c, idc_p, h_c;
       if constexpr (D == 0) {
-        idc_m = simd::load<V>(idc + ia - 1);
         idc_c = simd::load<V>(idc + ia);
         idc_p = simd::load<V>(idc + ia + 1);
-        h_m = simd::load<V>(hdx + ia - 1);
         h_c = simd::load<V>(hdx + ia);
       } else {
-        idc_m = V(idc[ia - 1]);
         idc_c = V(idc[ia]);
         idc_p = V(idc[ia + 1]);
-        h_m = V(hdx[ia - 1]);
         h_c = V(hdx[ia]);
       }
+      V q[5], l[5], r[5];
       for (int f = 0; f < 5; ++f) {
-        const V qmm = simd::load<V>(W[f] + c - 2 * s);
         const V qm = simd::load<V>(W[f] + c - s);
-        const V qc = simd::load<V>(W[f] + c);
+        q[f] = simd::load<V>(W[f] + c);
         const V qp = simd::load<V>(W[f] + c + s);
-        const V gmid = (qc - qm) * idc_c;
-        const V sm = recon_.slope((qm - qmm) * idc_m, gmid);
-        const V sc = recon_.slope(gmid, (qp - qc) * idc_p);
-        wl[f] = qm + sm * h_m;
-        wr[f] = qc - sc * h_c;
+        const V d = recon_.slope((q[f] - qm) * idc_c, (qp - q[f]) * idc_p) * h_c;
+        l[f] = q[f] - d;
+        r[f] = q[f] + d;
       }
-      // Positivity: fall back to the cell value on a side whose ρ or p is not > 0.
-      const auto badL = (wl[0] <= V(0.0)) || (wl[4] <= V(0.0));
-      const auto badR = (wr[0] <= V(0.0)) || (wr[4] <= V(0.0));
-      if (simd::any(badL) || simd::any(badR)) {
+      const auto bad = (l[0] <= V(0.0)) || (r[0] <= V(0.0)) || (l[4] <= V(0.0)) || (r[4] <= V(0.0));
+      if (simd::any(bad))
         for (int f = 0; f < 5; ++f) {
-          wl[f] = simd::select(badL, simd::load<V>(W[f] + c - s), wl[f]);
-          wr[f] = simd::select(badR, simd::load<V>(W[f] + c), wr[f]);
+          l[f] = simd::select(bad, q[f], l[f]);
+          r[f] = simd::select(bad, q[f], r[f]);
         }
+      for (int f = 0; f < 5; ++f) {
+        simd::store(lo[f] + o, l[f]);
+        simd::store(hi[f] + o, r[f]);
       }
     } else {
+      (void)s;
       (void)ia;
       for (int f = 0; f < 5; ++f) {
-        wl[f] = simd::load<V>(W[f] + c - s);
-        wr[f] = simd::load<V>(W[f] + c);
+        const V q = simd::load<V>(W[f] + c);
+        simd::store(lo[f] + o, q);
+        simd::store(hi[f] + o, q);
       }
     }
-    const prim<V> L{wl[0], {wl[1], wl[2], wl[3]}, wl[4]};
-    const prim<V> R{wr[0], {wr[1], wr[2], wr[3]}, wr[4]};
-    return flux::ale_flux(flux_, L, R, n, wn, gas_);
+  }
+
+  /// ALE Riemann flux from face values L (left/low side) and R at lane offsets.
+  template <class V>
+  PARAFSI_INLINE cons<V> face_flux(const double* const* L, index_t oL, const double* const* R, index_t oR,
+                                   const V& wn, const vec3<double>& n) const noexcept {
+    const prim<V> wl{simd::load<V>(L[0] + oL), {simd::load<V>(L[1] + oL), simd::load<V>(L[2] + oL),
+                     simd::load<V>(L[3] + oL)}, simd::load<V>(L[4] + oL)};
+    const prim<V> wr{simd::load<V>(R[0] + oR), {simd::load<V>(R[1] + oR), simd::load<V>(R[2] + oR),
+                     simd::load<V>(R[3] + oR)}, simd::load<V>(R[4] + oR)};
+    return flux::ale_flux(flux_, wl, wr, n, wn, gas_);
+  }
+
+  static PARAFSI_INLINE void store_flux(double* const* out, index_t o, const auto& F) noexcept {
+    simd::store(out[0] + o, F.rho);
+    simd::store(out[1] + o, F.m.x);
+    simd::store(out[2] + o, F.m.y);
+    simd::store(out[3] + o, F.m.z);
+    simd::store(out[4] + o, F.E);
   }
 
   /// Inviscid fluxes along axis D accumulated into dU (D = 0 initialises dU).
-  /// Lanes run along x in every direction; x faces go through a row buffer, y and z
-  /// faces through two rolling row buffers, so each cell is written once per axis.
+  /// Lanes run along x in every direction. x: face values of a whole row (cells −1…n)
+  /// then its n+1 face fluxes, then the update; y and z: rows are walked along the
+  /// axis with the previous row's high-face values and face fluxes kept, so every
+  /// slope is computed once and every cell is written once per axis.
   template <int D>
   void sweep(const stage_geometry& geo) {
     const index_t nx = grid_.n(0), ny = grid_.n(1), nz = grid_.n(2);
@@ -610,29 +625,32 @@ class solver {
     const double* x0 = grid_.centres(0);
     const double* x1 = grid_.centres(1);
     const double* x2 = grid_.centres(2);
+    auto ptrs = [](std::array<simd::aligned_vector<double>, 5>& a) {
+      return std::array<double*, 5>{a[0].data(), a[1].data(), a[2].data(), a[3].data(), a[4].data()};
+    };
     if constexpr (D == 0) {
       const double* idx = grid_.inv_widths(0);
       par_for(0, ny * nz, [&](index_t r) {
         const index_t j = r % ny, k = r / ny;
-        auto& fb = bufs[std::size_t(thread_id())].a;
+        auto& rb = bufs[std::size_t(thread_id())];
+        const auto lo = ptrs(rb.lo), hi = ptrs(rb.hi), fb = ptrs(rb.fa);
         const index_t base = grid_.index(0, j, k);
+        // Face values of cells −1 … n_x, stored at offset i + 1.
+        simd::for_each_pack(-1, nx + 1, [&](auto tag, index_t i) {
+          using V = typename decltype(tag)::type;
+          cell_faces<0, V>(base + i, 1, i, lo.data(), hi.data(), i + 1);
+        });
         // ŵ_x on x faces: v̂_x + ω̂_y z − ω̂_z y (constant along the row).
         const double wn = geo.vh[0] + geo.oh[1] * x2[k] - geo.oh[2] * x1[j];
-        simd::for_each_pack(0, nx + 1, [&](auto tag, index_t i) {
+        simd::for_each_pack(0, nx + 1, [&](auto tag, index_t i) {  // face i: cells i−1 | i
           using V = typename decltype(tag)::type;
-          const cons<V> F = face_flux<0, V>(base + i, 1, i, V(wn), n);
-          simd::store(fb[0].data() + i, F.rho);
-          simd::store(fb[1].data() + i, F.m.x);
-          simd::store(fb[2].data() + i, F.m.y);
-          simd::store(fb[3].data() + i, F.m.z);
-          simd::store(fb[4].data() + i, F.E);
+          store_flux(fb.data(), i, face_flux<V>(hi.data(), i, lo.data(), i + 1, V(wn), n));
         });
         simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
           using V = typename decltype(tag)::type;
           const V id = simd::load<V>(idx + i);
           for (int f = 0; f < 5; ++f)
-            simd::store(dU[f] + base + i,
-                        (simd::load<V>(fb[std::size_t(f)].data() + i) - simd::load<V>(fb[std::size_t(f)].data() + i + 1)) * id);
+            simd::store(dU[f] + base + i, (simd::load<V>(fb[f] + i) - simd::load<V>(fb[f] + i + 1)) * id);
         });
       });
     } else {
@@ -642,37 +660,38 @@ class solver {
       const double* idx = grid_.inv_widths(D);
       par_for(0, nT, [&](index_t q) {
         auto& rb = bufs[std::size_t(thread_id())];
-        auto* cur = &rb.a;
-        auto* prev = &rb.b;
-        for (index_t f = 0; f <= nD; ++f) {  // face f between cells f−1 and f along D
-          const index_t j = D == 1 ? f : q, k = D == 1 ? q : f;
+        auto lo = ptrs(rb.lo), hi = ptrs(rb.hi), hi_prev = ptrs(rb.hi_prev);
+        auto cur = ptrs(rb.fa), prev = ptrs(rb.fb);
+        for (index_t row = -1; row <= nD; ++row) {  // cells along D; face `row` is row−1 | row
+          const index_t j = D == 1 ? row : q, k = D == 1 ? q : row;
           const index_t base = grid_.index(0, j, k);
-          // ŵ on y faces: v̂_y + ω̂_z x − ω̂_x z;  on z faces: v̂_z + ω̂_x y − ω̂_y x.
-          const double wconst = D == 1 ? geo.vh[1] - geo.oh[0] * x2[k] : geo.vh[2] + geo.oh[0] * x1[j];
-          const double wslope = D == 1 ? geo.oh[2] : -geo.oh[1];
           simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
             using V = typename decltype(tag)::type;
-            const V wn = V(wconst) + V(wslope) * simd::load<V>(x0 + i);
-            const cons<V> F = face_flux<D, V>(base + i, s, f, wn, n);
-            simd::store((*cur)[0].data() + i, F.rho);
-            simd::store((*cur)[1].data() + i, F.m.x);
-            simd::store((*cur)[2].data() + i, F.m.y);
-            simd::store((*cur)[3].data() + i, F.m.z);
-            simd::store((*cur)[4].data() + i, F.E);
+            cell_faces<D, V>(base + i, s, row, lo.data(), hi.data(), i);
           });
-          if (f > 0) {
-            const index_t cbase = base - s;  // cell f−1 receives F_{f−1/2} − F_{f+1/2}
-            const double id = idx[f - 1];
+          if (row >= 0) {
+            // ŵ on y faces: v̂_y + ω̂_z x − ω̂_x z;  on z faces: v̂_z + ω̂_x y − ω̂_y x.
+            const double wconst = D == 1 ? geo.vh[1] - geo.oh[0] * x2[k] : geo.vh[2] + geo.oh[0] * x1[j];
+            const double wslope = D == 1 ? geo.oh[2] : -geo.oh[1];
             simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
               using V = typename decltype(tag)::type;
-              for (int c = 0; c < 5; ++c)
-                simd::store(dU[c] + cbase + i,
-                            simd::load<V>(dU[c] + cbase + i) +
-                                (simd::load<V>((*prev)[std::size_t(c)].data() + i) -
-                                 simd::load<V>((*cur)[std::size_t(c)].data() + i)) * V(id));
+              const V wn = V(wconst) + V(wslope) * simd::load<V>(x0 + i);
+              store_flux(cur.data(), i, face_flux<V>(hi_prev.data(), i, lo.data(), i, wn, n));
             });
+            if (row >= 1) {
+              const index_t cbase = base - s;  // cell row−1 receives F_{row−1/2} − F_{row+1/2}
+              const double id = idx[row - 1];
+              simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
+                using V = typename decltype(tag)::type;
+                for (int c = 0; c < 5; ++c)
+                  simd::store(dU[c] + cbase + i,
+                              simd::load<V>(dU[c] + cbase + i) +
+                                  (simd::load<V>(prev[c] + i) - simd::load<V>(cur[c] + i)) * V(id));
+              });
+            }
+            std::swap(cur, prev);
           }
-          std::swap(cur, prev);
+          std::swap(hi, hi_prev);
         }
       });
     }

@@ -24,6 +24,7 @@
 #pragma once
 #include <array>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -71,7 +72,7 @@ struct gT0 {}; struct gT1 {}; struct gT2 {};
 struct mu_t { static constexpr const char* name = "mu_t"; };
 struct wall_distance { static constexpr const char* name = "wall_distance"; };
 // Sources (per unit volume and time).
-struct s_mx {}; struct s_my {}; struct s_mz {}; struct s_E {};
+struct s_mx {}; struct s_my {}; struct s_mz {}; struct s_E {}; struct s_rho {};
 struct sponge_sigma {};
 }  // namespace field
 
@@ -88,6 +89,22 @@ struct phase_times {
   double boundaries = 0, primitives = 0, fluxes = 0, viscous = 0, sources = 0, update = 0;
   double total() const { return boundaries + primitives + fluxes + viscous + sources + update; }
 };
+
+/// A face whose flux the user (an embedded coupling) replaces: the face between the
+/// cells `low` and `high` (flat indices, high = low + stride(axis)).
+struct face_context {
+  index_t low = 0, high = 0;
+  int axis = 0;
+  prim<double> L{}, R{};     ///< reconstructed states on the low and high side
+  vec3<double> n{};          ///< unit normal (inertial), from low to high
+  double wn = 0;             ///< grid normal speed of the face
+  double area = 0;           ///< face area (m²)
+  Eigen::Vector3d centre{};  ///< face centre in box coordinates ξ
+};
+/// Fluxes (per unit area, ALE form) through a patched face: `low_side` is what the
+/// low cell sends through it, `high_side` what the high cell receives. They may differ
+/// (a membrane in the face takes the difference as its load).
+using face_handler = std::function<void(const face_context&, cons<double>& low_side, cons<double>& high_side)>;
 
 /// Totals over interior cells (inertial frame): mass, momentum, total energy.
 struct totals {
@@ -241,6 +258,11 @@ class solver {
     if (!sources_) sources_.emplace(grid_.total_cells(), 0.0);
   }
   bool has_sources() const noexcept { return sources_.has_value(); }
+  /// Mass source per cell (kg/(m³ s)), e.g. a porous through-flow; zero by default.
+  double* source_mass() {
+    require(sources_.has_value(), "fluid::solver::source_mass: call enable_sources() first");
+    return sources_->template get<field::s_rho>();
+  }
   double* source(int component) {
     require(sources_.has_value(), "fluid::solver::source: call enable_sources() first");
     switch (component) {
@@ -250,6 +272,18 @@ class solver {
       default: return sources_->template get<field::s_E>();
     }
   }
+  /// Replace the Riemann flux on a set of faces (cell index of the high side, axis)
+  /// by `handler` from the next stage on; the regular flux is computed first and
+  /// corrected, so the faces cost a scalar recomputation each. Cleared by passing {}.
+  void set_face_patches(std::vector<std::pair<index_t, int>> faces, face_handler handler) {
+    for (const auto& [c, d] : faces)
+      require(d >= 0 && d < 3 && c >= grid_.stride(d) && c < grid_.total_cells(),
+              "fluid::solver::set_face_patches: bad face (cell ", c, ", axis ", d, ")");
+    patches_ = std::move(faces);
+    patch_handler_ = std::move(handler);
+  }
+  std::size_t face_patch_count() const noexcept { return patches_.size(); }
+
   /// Distance to the nearest body per cell (mixing-length closure); +∞ by default.
   double* wall_distance() requires needs_wall_distance {
     return turb_store_.template get<field::wall_distance>();
@@ -421,6 +455,7 @@ class solver {
       sweep<1>(geo);
       sweep<2>(geo);
     });
+    if (!patches_.empty()) timed(times_.fluxes, [&] { patch_faces(geo); });
     if constexpr (is_viscous) timed(times_.viscous, [&] { viscous_fluxes(geo); });
     if (sources_ || sponge_) timed(times_.sources, [&] { add_sources(); });
   }
@@ -697,6 +732,55 @@ class solver {
     }
   }
 
+  /// Patched faces: recompute the regular flux, ask the handler for the two one-sided
+  /// fluxes, and correct the two cells' rates. Serial, in list order (deterministic).
+  void patch_faces(const stage_geometry& geo) {
+    double* dU[5] = {dU_.template get<field::rho>(), dU_.template get<field::mx>(), dU_.template get<field::my>(),
+                     dU_.template get<field::mz>(), dU_.template get<field::E>()};
+    const index_t sy = grid_.stride(1), sz = grid_.stride(2);
+    for (const auto& [c, d] : patches_) {
+      const index_t s = grid_.stride(d), m = c - s;
+      // Axis indices of the high cell.
+      const index_t k = c / sz - ng, j = (c % sz) / sy - ng, i = c % sy - ng;
+      const index_t ijk[3] = {i, j, k};
+      double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
+      double* pl[5] = {&lo_m[0], &lo_m[1], &lo_m[2], &lo_m[3], &lo_m[4]};
+      double* ph[5] = {&hi_m[0], &hi_m[1], &hi_m[2], &hi_m[3], &hi_m[4]};
+      double* ql[5] = {&lo_c[0], &lo_c[1], &lo_c[2], &lo_c[3], &lo_c[4]};
+      double* qh[5] = {&hi_c[0], &hi_c[1], &hi_c[2], &hi_c[3], &hi_c[4]};
+      auto faces_of = [&](index_t cell, index_t ia, double** lo, double** hi) {
+        if (d == 0) cell_faces<0, double>(cell, s, ia, lo, hi, 0);
+        else if (d == 1) cell_faces<1, double>(cell, s, ia, lo, hi, 0);
+        else cell_faces<2, double>(cell, s, ia, lo, hi, 0);
+      };
+      faces_of(m, ijk[d] - 1, pl, ph);
+      faces_of(c, ijk[d], ql, qh);
+      face_context fc;
+      fc.low = m;
+      fc.high = c;
+      fc.axis = d;
+      fc.L = {hi_m[0], {hi_m[1], hi_m[2], hi_m[3]}, hi_m[4]};
+      fc.R = {lo_c[0], {lo_c[1], lo_c[2], lo_c[3]}, lo_c[4]};
+      fc.n = geo.n[std::size_t(d)];
+      fc.centre = {grid_.centre(0, i), grid_.centre(1, j), grid_.centre(2, k)};
+      fc.centre[d] = grid_.face(d, ijk[d]);
+      fc.wn = geo.vh[d] + geo.oh.cross(fc.centre)[d];
+      const int a = (d + 1) % 3, b = (d + 2) % 3;
+      fc.area = grid_.width(a, ijk[a]) * grid_.width(b, ijk[b]);
+      const cons<double> F = flux::ale_flux(flux_, fc.L, fc.R, fc.n, fc.wn, gas_);
+      cons<double> Flo = F, Fhi = F;
+      patch_handler_(fc, Flo, Fhi);
+      const double idm = grid_.inv_widths(d)[ijk[d] - 1], idc = grid_.inv_widths(d)[ijk[d]];
+      const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
+      const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
+      const bool m_interior = ijk[d] - 1 >= 0, c_interior = ijk[d] < grid_.n(d);
+      for (int q = 0; q < 5; ++q) {
+        if (m_interior) dU[q][m] += dlo[q] * idm;
+        if (c_interior) dU[q][c] -= dhi[q] * idc;
+      }
+    }
+  }
+
   /// Viscous and heat fluxes (laminar + eddy viscosity), in box components:
   /// τ̂ = μ_eff(∇û + ∇ûᵀ − ⅔ ∇·û I), q̂ = −k_eff ∇T, face-normal derivatives from
   /// two-point differences, tangential ones from the average of the two cells'
@@ -859,6 +943,7 @@ class solver {
       for (index_t i = 0; i < nx; ++i) {
         const index_t c = base + i;
         if (sources_) {
+          dU[0][c] += sources_->template get<field::s_rho>()[c];
           dU[1][c] += sources_->template get<field::s_mx>()[c];
           dU[2][c] += sources_->template get<field::s_my>()[c];
           dU[3][c] += sources_->template get<field::s_mz>()[c];
@@ -943,10 +1028,12 @@ class solver {
   prim_storage W_;
   [[no_unique_address]] viscous_storage visc_store_;
   [[no_unique_address]] turbulence_storage turb_store_;
-  std::optional<soa<field::s_mx, field::s_my, field::s_mz, field::s_E>> sources_;
+  std::optional<soa<field::s_mx, field::s_my, field::s_mz, field::s_E, field::s_rho>> sources_;
   std::optional<soa<field::sponge_sigma>> sponge_;
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   std::vector<row_buffers> bufs_;
+  std::vector<std::pair<index_t, int>> patches_;
+  face_handler patch_handler_;
   phase_times times_{};
   bool threaded_ = true;
 };

@@ -11,6 +11,8 @@
 ///                    through the assembly's load hook, their reactions are accumulated
 ///                    as fluid impulses;
 ///   4. fluid       — impulses → sources (J, W)/(Δt_f V_cell), one fluid step;
+///   (a `fluid_first` coupling — coupling::embedded — runs 4 before 3: its loads are
+///   the face fluxes of the fluid step, applied to the structure substeps after it);
 ///   5. time        — t += Δt_f.
 ///
 /// Leaving a part out: `no_fluid` or `no_structure` in its place (with
@@ -52,6 +54,12 @@ class explicit_stepper {
   static constexpr bool has_fluid = !std::is_same_v<Fluid, no_fluid>;
   static constexpr bool has_structure = !std::is_same_v<Structure, no_structure>;
   static constexpr bool coupled = Coupling::active;
+  /// Couplings whose loads come from the fluid step's fluxes (coupling::embedded)
+  /// declare `fluid_first = true`: the fluid step runs before the structure substeps.
+  static constexpr bool fluid_first = [] {
+    if constexpr (requires { Coupling::fluid_first; }) return coupled && bool(Coupling::fluid_first);
+    else return false;
+  }();
   static_assert(has_fluid || has_structure, "explicit_stepper: give a fluid solver, a structure assembly or both");
   static_assert(!coupled || (has_fluid && has_structure),
                 "explicit_stepper: a coupling needs both a fluid and a structure; use coupling::none with "
@@ -103,38 +111,49 @@ class explicit_stepper {
       timed(times_.move_frame, [&] { coupling_.plan(fluid_, dt); });
       timed(times_.exchange, [&] { coupling_.exchange(fluid_, structure_, dt); });
     }
-    if constexpr (has_structure) {
-      timed(times_.structure, [&] {
-        double crit = structure_.stable_dt();
-        if constexpr (coupled) crit = std::min(crit, coupling_.structure_dt());
-        const long m = structure::central_difference::substeps(dt, crit);
-        if (m > max_substeps)
-          throw invalid_input(detail::concat("explicit_stepper::step: the structure needs ", m,
-                                             " substeps in a step of ", dt, " s (stable substep ", crit,
-                                             " s, max_substeps = ", max_substeps,
-                                             "); reduce the fluid step or the coupling stiffness (PFAC)"));
-        const double ds = dt / double(m);
-        for (long k = 0; k < m; ++k) {
-          const double prev = prev_substep_ < 0 ? ds : prev_substep_;
-          const double kick = 0.5 * (prev + ds);
-          if constexpr (coupled) {
-            const double tau = double(k) * ds;
-            structure_.step(ds, [&](structure::load_sink& sink, double) {
-              coupling_.apply(sink, structure_.node_set(), tau, kick, ds);
-            });
-          } else {
-            structure_.step(ds);
+    auto structure_phase = [&] {
+      if constexpr (has_structure) {
+        timed(times_.structure, [&] {
+          double crit = structure_.stable_dt();
+          if constexpr (coupled) crit = std::min(crit, coupling_.structure_dt());
+          const long m = structure::central_difference::substeps(dt, crit);
+          if (m > max_substeps)
+            throw invalid_input(detail::concat("explicit_stepper::step: the structure needs ", m,
+                                               " substeps in a step of ", dt, " s (stable substep ", crit,
+                                               " s, max_substeps = ", max_substeps,
+                                               "); reduce the fluid step or the coupling stiffness (PFAC)"));
+          const double ds = dt / double(m);
+          for (long k = 0; k < m; ++k) {
+            const double prev = prev_substep_ < 0 ? ds : prev_substep_;
+            const double kick = 0.5 * (prev + ds);
+            if constexpr (coupled) {
+              const double tau = double(k) * ds;
+              structure_.step(ds, [&](structure::load_sink& sink, double) {
+                coupling_.apply(sink, structure_.node_set(), tau, kick, ds);
+              });
+            } else {
+              structure_.step(ds);
+            }
+            prev_substep_ = ds;
           }
-          prev_substep_ = ds;
-        }
-        last_m_ = m;
-      });
-    }
-    if constexpr (has_fluid) {
-      timed(times_.fluid, [&] {
-        if constexpr (coupled) coupling_.finish(fluid_, dt);
-        fluid_.step(dt);
-      });
+          last_m_ = m;
+        });
+      }
+    };
+    auto fluid_phase = [&] {
+      if constexpr (has_fluid) {
+        timed(times_.fluid, [&] {
+          if constexpr (coupled) coupling_.finish(fluid_, dt);
+          fluid_.step(dt);
+        });
+      }
+    };
+    if constexpr (fluid_first) {
+      fluid_phase();
+      structure_phase();
+    } else {
+      structure_phase();
+      fluid_phase();
     }
     t_ += dt;
     ++steps_;

@@ -1,0 +1,253 @@
+// Drop-scene builders: packed shapes, lines, riser, payload, masses, the C-9 variant, rejection.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include <parafsi/model/drop_scene.hpp>
+
+namespace pf = parafsi;
+namespace md = parafsi::model;
+using pf::index_t;
+
+namespace {
+double max_edge_strain(const md::canopy_mesh& c, const std::vector<Eigen::Vector3d>& x) {
+  double e = 0;
+  for (const auto& t : c.triangles)
+    for (int a = 0; a < 3; ++a) {
+      const auto i = std::size_t(t[std::size_t(a)]), j = std::size_t(t[std::size_t((a + 1) % 3)]);
+      const double L0 = (c.positions[j] - c.positions[i]).norm(), L = (x[j] - x[i]).norm();
+      e = std::max(e, std::abs(L / L0 - 1.0));
+    }
+  return e;
+}
+double max_radius(const std::vector<Eigen::Vector3d>& x, std::size_t n) {
+  double r = 0;
+  for (std::size_t i = 0; i < n; ++i) r = std::max(r, x[i].head<2>().norm());
+  return r;
+}
+}  // namespace
+
+TEST_CASE("packed shapes keep the reference and meet the requested radius scale") {
+  const auto c = md::flat_circular_canopy({});
+  const auto flat = md::packed_positions(c, md::packed_shape::constructed());
+  CHECK(max_edge_strain(c, flat) == 0.0);
+  for (double s : {0.1, 0.2, 0.3}) {
+    const auto x = md::packed_positions(c, md::packed_shape::reduced_radius(s));
+    CHECK(max_radius(x, x.size()) == doctest::Approx(s * c.skirt_radius).epsilon(1e-12));
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      CHECK(x[i].head<2>().norm() == doctest::Approx(s * c.positions[i].head<2>().norm()).epsilon(1e-12));
+      CHECK(x[i].z() == c.positions[i].z());
+    }
+  }
+  // Star fold: isometric (every edge keeps its length), seams on the cone of half-angle theta_s.
+  for (double deg : {0.0, 3.0, 10.0}) {
+    const double ts = deg * std::numbers::pi / 180;
+    const auto x = md::packed_positions(c, md::packed_shape::star_fold(ts));
+    const double e = max_edge_strain(c, x);
+    std::printf("star fold theta_s = %4.1f deg: theta_m = %.2f deg, max |edge strain| = %.2e, radius %.4f m\n", deg,
+                md::star_fold_centreline_angle(8, ts) * 180 / std::numbers::pi, e, max_radius(x, x.size()));
+    CHECK(e < 1e-12);
+    for (const auto& seam : c.seams)
+      for (const index_t i : seam) {
+        const Eigen::Vector3d p = x[std::size_t(i)];
+        CHECK(std::atan2(p.head<2>().norm(), -p.z()) == doctest::Approx(ts).epsilon(1e-9));
+      }
+  }
+  CHECK_THROWS_WITH_AS(md::packed_positions(c, md::packed_shape::reduced_radius(0.0)),
+                       doctest::Contains("scale s must be in (0, 1], got 0"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::packed_positions(c, md::packed_shape::reduced_radius(1.5)), doctest::Contains("got 1.5"),
+                       pf::invalid_input);
+}
+
+TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geometry") {
+  for (auto shape : {md::packed_shape::constructed(), md::packed_shape::reduced_radius(0.2),
+                     md::packed_shape::star_fold(5 * std::numbers::pi / 180)}) {
+    auto p = md::drop_scene_parameters::paper("mat59225");
+    p.shape = shape;
+    const auto s = md::build_drop_scene(p);
+    const int N = 8;
+    const double Ls = 1.0, Lr = 0.08;
+    CHECK(p.line_length() == 1.0);
+    CHECK(p.riser_length() == doctest::Approx(0.08));
+    // Lines: N lines, each Ls in rest length and in straight length, ending at the confluence.
+    const auto& L = s.cable(md::cable_kind::suspension_line);
+    CHECK(L.segments.size() == std::size_t(N * p.line_segments));
+    CHECK(L.total_rest_length() == doctest::Approx(N * Ls).epsilon(1e-12));
+    REQUIRE(s.suspension.lines.size() == std::size_t(N));
+    for (std::size_t k = 0; k < std::size_t(N); ++k) {
+      const auto& path = s.suspension.lines[k];
+      // Every line starts at a skirt node of a seam (its line attachment node).
+      CHECK(path.front() == s.canopy.line_attachment[k]);
+      const unsigned tag = s.canopy.node_tag[std::size_t(path.front())];
+      CHECK((tag & md::canopy_tag::skirt));
+      CHECK((tag & md::canopy_tag::seam));
+      CHECK(path.back() == s.suspension.confluence);
+      CHECK((s.positions[std::size_t(path.back())] - s.positions[std::size_t(path.front())]).norm() ==
+            doctest::Approx(Ls).epsilon(1e-12));
+    }
+    // Riser: confluence to hanging point, Lr long, hanging point at the payload's r_T.
+    const auto& R = s.cable(md::cable_kind::riser);
+    CHECK(R.total_rest_length() == doctest::Approx(Lr).epsilon(1e-12));
+    CHECK((s.positions[std::size_t(s.suspension.hanging_point)] - s.positions[std::size_t(s.suspension.confluence)])
+              .norm() == doctest::Approx(Lr).epsilon(1e-12));
+    REQUIRE(s.attachments.size() == 1);
+    CHECK(s.attachments[0].node == s.suspension.hanging_point);
+    CHECK((s.payload.hanging_point_world() - s.positions[std::size_t(s.suspension.hanging_point)]).norm() < 1e-12);
+    CHECK((s.payload.position - Eigen::Vector3d(0, 0, 35)).norm() < 1e-12);
+    CHECK(s.payload.mass == 1.8);
+    CHECK(s.payload.hanging_point.z() == doctest::Approx(0.05));
+    CHECK(s.payload.inertia_diagonal.x() == doctest::Approx(1.8 / 12 * (0.15 * 0.15 + 0.1 * 0.1)));
+    // Confluence distance from the skirt plane: sqrt(Ls^2 - rho^2), rho the packed skirt corner radius.
+    const double rho = (s.frame.conjugate() * (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset))
+                           .head<2>()
+                           .norm();
+    const double zs = (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset).z();
+    const double zc = (s.positions[std::size_t(s.suspension.confluence)] - s.offset).z();
+    CHECK(zs - zc == doctest::Approx(std::sqrt(Ls * Ls - rho * rho)).epsilon(1e-12));
+    // Vertical drop at rest: axis +z, velocities zero.
+    CHECK((s.axis() - Eigen::Vector3d::UnitZ()).norm() < 1e-12);
+    for (const auto& v : s.velocities) CHECK(v.norm() == 0.0);
+    // Reference geometry = the cut pattern (rigidly placed): area and lengths unchanged.
+    double Aref = 0;
+    for (const auto& t : s.triangles)
+      Aref += 0.5 * (s.reference[std::size_t(t[1])] - s.reference[std::size_t(t[0])])
+                        .cross(s.reference[std::size_t(t[2])] - s.reference[std::size_t(t[0])])
+                        .norm();
+    CHECK(Aref == doctest::Approx(std::numbers::pi / 4 * (1 - 0.01)).epsilon(1e-12));
+    // Masses: cloth = areal density x reference area; total = cloth + tapes + bands + lines + riser + payload.
+    double cloth = 0;
+    for (index_t i = 0; i < s.canopy_nodes; ++i) cloth += s.lumped_mass[std::size_t(i)];
+    double cables = 0;
+    for (const auto& cs : s.cables) cables += cs.material.mass_per_length * cs.total_rest_length();
+    CHECK(s.canopy_cloth_mass() == doctest::Approx(0.080 * std::numbers::pi / 4 * 0.99).epsilon(1e-12));
+    CHECK(s.total_mass() == doctest::Approx(1.8 + s.canopy_cloth_mass() + cables).epsilon(1e-12));
+    CHECK(cloth > s.canopy_cloth_mass());  // cloth + tapes/bands on canopy nodes
+    // Skirt tape rest length = gore polygon perimeter.
+    const double Rs = s.canopy.skirt_radius;
+    CHECK(s.cable(md::cable_kind::skirt_tape).total_rest_length() ==
+          doctest::Approx(2 * N * Rs * std::sin(std::numbers::pi / N)).epsilon(1e-12));
+    CHECK(s.cable(md::cable_kind::radial_band).segments.size() > 0);
+    // Riser = N lines in parallel.
+    CHECK(R.material.EA() == doctest::Approx(N * L.material.EA()));
+    // Element arrays in the forms the structure module takes.
+    CHECK(s.warp.size() == s.triangles.size());
+    CHECK(s.reference.size() == s.positions.size());
+    CHECK(s.point_mass.size() == s.positions.size());
+    for (const auto& cs : s.cables) CHECK(cs.rest_length.size() == cs.segments.size());
+    // Packed radius scale in the scene.
+    if (shape.kind == md::packed_kind::reduced_radius) CHECK(rho == doctest::Approx(0.2 * Rs).epsilon(1e-12));
+    std::printf("paper scene (%s): %ld nodes, %zu triangles, cloth %.4f kg, total %.4f kg, line EA %.0f N, "
+                "confluence %.4f m below skirt\n",
+                shape.name(), s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(),
+                L.material.EA(), zs - zc);
+  }
+}
+
+TEST_CASE("scene: flight-path angle rotates the axis against the velocity") {
+  auto p = md::drop_scene_parameters::paper();
+  p.flight_path_angle = 30;
+  p.initial_speed = 20;
+  const auto s = md::build_drop_scene(p);
+  const Eigen::Vector3d vhat(std::cos(std::numbers::pi / 6), 0, -std::sin(std::numbers::pi / 6));
+  CHECK((s.axis() + vhat).norm() < 1e-12);
+  CHECK((s.payload.velocity - 20 * vhat).norm() < 1e-12);
+  CHECK((s.velocities[0] - 20 * vhat).norm() < 1e-12);
+  // The canopy is up-stream (behind) the payload along the flight direction.
+  CHECK((s.positions[std::size_t(s.canopy.vent_centre)] - s.payload.position).dot(vhat) < -1.0);
+}
+
+TEST_CASE("C-9 variant: 28 gores, 28 ft, 13.4 m/s") {
+  const auto p = md::drop_scene_parameters::c9();
+  const auto s = md::build_drop_scene(p);
+  CHECK(p.canopy.gores == 28);
+  CHECK(p.canopy.nominal_diameter == doctest::Approx(8.5344));
+  CHECK(s.canopy.line_attachment.size() == 28);
+  CHECK(s.suspension.lines.size() == 28);
+  CHECK(s.canopy.bands.size() == 14);
+  CHECK(s.canopy_reference_area() == doctest::Approx(std::numbers::pi / 4 * 8.5344 * 8.5344 * 0.99).epsilon(1e-12));
+  CHECK(s.payload.velocity.z() == doctest::Approx(-13.4));
+  CHECK(s.cable(md::cable_kind::suspension_line).total_rest_length() == doctest::Approx(28 * 8.5344).epsilon(1e-12));
+  CHECK(s.cable(md::cable_kind::riser).total_rest_length() == doctest::Approx(0.08 * 8.5344).epsilon(1e-12));
+  CHECK(s.fabric.name == "c9_mil_c_7020");
+  std::printf("C-9 scene: %ld nodes, %zu triangles, cloth %.3f kg, total %.3f kg, fabric E*t %.0f N/m, line EA %.0f N\n",
+              s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(), s.moduli.stiffness(),
+              s.cable(md::cable_kind::suspension_line).material.EA());
+}
+
+TEST_CASE("scene: bad parameters are rejected with the value named") {
+  auto bad = [](auto f) {
+    auto p = md::drop_scene_parameters::paper();
+    f(p);
+    return p;
+  };
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.canopy.gores = 1; })), doctest::Contains("got 1"),
+                       pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.canopy.vent_ratio = 1.2; })),
+                       doctest::Contains("got 1.2"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.payload.mass = -2; })),
+                       doctest::Contains("mass must be > 0, got -2"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line_length_ratio = -1; })),
+                       doctest::Contains("got -1"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.shape = md::packed_shape::constructed(); p.line_length_ratio = 0.5; })),
+                       doctest::Contains("shorter than the attachment radius"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.riser_ratio = 0; })),
+                       doctest::Contains("riser ratio Lr/Ls must be > 0, got 0"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line_segments = 0; })),
+                       doctest::Contains("got 0"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.fabric = "silk"; })),
+                       doctest::Contains("unknown fabric 'silk'"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line.elongation = -0.25; })),
+                       doctest::Contains("suspension line): elongation at break must be > 0, got -0.25"),
+                       pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.payload.size.x() = -0.1; })),
+                       doctest::Contains("got -0.1"), pf::invalid_input);
+}
+
+#include <parafsi/structure/structure.hpp>
+
+TEST_CASE("scene data plugs into the structure module as is; lumped masses match") {
+  namespace st = parafsi::structure;
+  const auto s = md::build_drop_scene(md::drop_scene_parameters::paper());
+  st::nodes nodes;
+  for (std::size_t i = 0; i < s.positions.size(); ++i) nodes.add(s.positions[i], s.velocities[i], s.point_mass[i]);
+  st::triangle_mesh tm;
+  tm.triangles = s.triangles;
+  tm.reference = s.reference;
+  tm.warp_per_element = s.warp;
+  const auto& m = s.moduli;
+  st::membrane_tri membrane{tm, st::material::fabric<>{m.E11, m.E22, m.nu12, m.G12, m.areal_density, m.thickness},
+                            st::membrane_options{0.05}};
+  auto part = [&](md::cable_kind k) {
+    const auto& c = s.cable(k);
+    return st::cable{st::line_mesh{c.segments, c.rest_length},
+                     st::material::cable{c.material.EA(), c.material.mass_per_length, c.material.damping_ratio, 0.0}};
+  };
+  st::attachment payload{st::rigid_body{st::rigid_body::cuboid(s.payload.mass, s.payload.size), s.payload.position,
+                                        s.payload.attitude, s.payload.velocity}};
+  for (const auto& a : s.attachments) payload.attach(a.node, a.r_body);
+  st::assembly chute{std::move(nodes),
+                     std::move(membrane),
+                     part(md::cable_kind::suspension_line),
+                     part(md::cable_kind::riser),
+                     part(md::cable_kind::skirt_tape),
+                     part(md::cable_kind::vent_tape),
+                     part(md::cable_kind::radial_band),
+                     std::move(payload)};
+  chute.integrator().gravity = {0, 0, -s.params.gravity};
+  chute.finalize();
+  for (index_t i = 0; i < s.node_count(); ++i)
+    CHECK(chute.node_set().mass(i) == doctest::Approx(s.lumped_mass[std::size_t(i)]).epsilon(1e-12));
+  // The body received the hanging node's lumped mass.
+  CHECK(chute.part<6>().body().mass() ==
+        doctest::Approx(s.payload.mass + s.lumped_mass[std::size_t(s.suspension.hanging_point)]).epsilon(1e-12));
+  const double dt = chute.stable_dt();
+  std::printf("assembly from the scene: stable structural step %.3e s\n", dt);
+  CHECK(dt > 1e-6);
+  for (int n = 0; n < 50; ++n) chute.step(dt);
+  CHECK(std::isfinite(chute.part<6>().body().position().z()));
+  // Free fall for 50 steps: everything falls together (no strain yet from a reduced-radius start).
+  const double t = chute.time();
+  CHECK(chute.part<6>().body().position().z() == doctest::Approx(35.0 - 0.5 * 9.81 * t * t).epsilon(1e-6));
+}

@@ -37,25 +37,13 @@ struct options {
 constexpr double half = 5.0, length = 10.0, eps = 5.0, gamma_ = 1.4;
 constexpr int quadrature = 4;
 
-struct vortex {
-  double rho_inf = 1.0, p_inf = 1.0, u_inf = 1.0, v_inf = 1.0;
-  double cx = 0.0, cy = 0.0;  // centre
-
-  static double wrap(double d) {  // nearest periodic image in [-5, 5)
-    return d - length * std::floor((d + half) / length);
+struct vortex : pf::fluid::reference::isentropic_vortex {
+  vortex() {
+    eps = ::eps;
+    gamma = gamma_;
+    period = length;
   }
   double dT_max() const { return (gamma_ - 1.0) * eps * eps / (8.0 * gamma_ * std::numbers::pi * std::numbers::pi) * std::exp(1.0); }
-  pf::fluid::prim<double> operator()(double x, double y) const {
-    const double dx = wrap(x - cx), dy = wrap(y - cy);
-    const double r2 = dx * dx + dy * dy;
-    const double a = eps / (2.0 * std::numbers::pi) * std::exp(0.5 * (1.0 - r2));
-    const double T_inf = p_inf / rho_inf;
-    const double T = T_inf - (gamma_ - 1.0) * eps * eps / (8.0 * gamma_ * std::numbers::pi * std::numbers::pi) *
-                                 std::exp(1.0 - r2);
-    const double rho = rho_inf * std::pow(T / T_inf, 1.0 / (gamma_ - 1.0));
-    const double p = p_inf * std::pow(T / T_inf, gamma_ / (gamma_ - 1.0));
-    return {rho, {u_inf - a * dy, v_inf + a * dx, 0.0}, p};
-  }
   /// Cell average of ρ over [x0, x1] × [y0, y1] (q × q midpoint rule).
   double mean_density(double x0, double x1, double y0, double y1, int q) const {
     double acc = 0.0;

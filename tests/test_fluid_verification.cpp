@@ -14,14 +14,7 @@ using pft::prim;
 namespace {
 constexpr double pi = std::numbers::pi;
 
-prim yee_vortex(const Eigen::Vector3d& x, double gamma = 1.4) {
-  // Shu/Yee isentropic vortex: ε = 5, centre (0,0), free stream (1, 1), ρ∞ = p∞ = 1.
-  const double eps = 5.0, r2 = x[0] * x[0] + x[1] * x[1];
-  const double f = eps / (2 * pi) * std::exp(0.5 * (1 - r2));
-  const double T = 1.0 - (gamma - 1) * eps * eps / (8 * gamma * pi * pi) * std::exp(1 - r2);
-  const double rho = std::pow(T, 1 / (gamma - 1));
-  return {rho, {1.0 - f * x[1], 1.0 + f * x[0], 0.0}, rho * T};
-}
+prim yee_vortex(const Eigen::Vector3d& x) { return fluid::reference::isentropic_vortex{}(x[0], x[1]); }
 
 template <class Flux, class Recon>
 double vortex_l1(int n, double* seconds = nullptr) {
@@ -40,42 +33,17 @@ double vortex_l1(int n, double* seconds = nullptr) {
   return err / double(n * n);
 }
 
-prim gresho(const Eigen::Vector3d& x, double mach, double gamma = 1.4) {
-  const double dx = x[0] - 0.5, dy = x[1] - 0.5, r = std::sqrt(dx * dx + dy * dy);
-  const double p0 = 1.0 / (gamma * mach * mach);
-  double uphi, p;
-  if (r < 0.2) {
-    uphi = 5 * r;
-    p = p0 + 12.5 * r * r;
-  } else if (r < 0.4) {
-    uphi = 2 - 5 * r;
-    p = p0 + 12.5 * r * r + 4 - 20 * r + 4 * std::log(5 * r);
-  } else {
-    uphi = 0;
-    p = p0 - 2 + 4 * std::log(2.0);
-  }
-  const double s = r > 0 ? uphi / r : 0.0;
-  return {1.0, {-s * dy, s * dx, 0.0}, p};
-}
-
 template <class S>
 double kinetic_energy(const S& s) {
-  double ke = 0;
-  const auto& g = s.grid();
-  for (index_t k = 0; k < g.n(2); ++k)
-    for (index_t j = 0; j < g.n(1); ++j)
-      for (index_t i = 0; i < g.n(0); ++i) {
-        const auto q = s.conserved(i, j, k);
-        ke += 0.5 * dot(q.m, q.m) / q.rho * g.cell_volume(i, j, k);
-      }
-  return ke;
+  return s.totals().kinetic;
 }
 
 template <class Flux>
 double gresho_retention(double mach, int n, double t_end) {
   auto grid = fluid::rectilinear_grid::uniform({n, n, 2}, {0, 0, 0}, {1, 1, 2.0 / n});
   fluid::solver s{grid, boundary::set::all(boundary::periodic{}), Flux{}, recon::muscl<limiter::van_leer>{}};
-  s.initialize_averaged([&](const Eigen::Vector3d& x) { return gresho(x, mach); }, 4);
+  const fluid::reference::gresho_vortex g{mach};
+  s.initialize_averaged([&](const Eigen::Vector3d& x) { return g(x[0], x[1]); }, 4);
   const double ke0 = kinetic_energy(s);
   pft::run_to(s, t_end, 0.5);
   return kinetic_energy(s) / ke0;
@@ -119,13 +87,8 @@ TEST_CASE("viscous Taylor–Green vortex decays at its analytic rate exp(-4 nu t
   const double nu = 0.1, U0 = 1.0, p0 = 100.0, t_end = 1.0;
   auto grid = fluid::rectilinear_grid::uniform({n, n, 2}, {0, 0, 0}, {2 * pi, 2 * pi, 4 * pi / n});
   fluid::solver s{grid, boundary::set::all(boundary::periodic{}), flux::hllc_lm{}, viscosity::constant{nu, 0.72}};
-  s.initialize_averaged(
-      [&](const Eigen::Vector3d& x) {
-        return prim{1.0,
-                    {U0 * std::sin(x[0]) * std::cos(x[1]), -U0 * std::cos(x[0]) * std::sin(x[1]), 0.0},
-                    p0 + 0.25 * U0 * U0 * (std::cos(2 * x[0]) + std::cos(2 * x[1]))};
-      },
-      4);
+  const fluid::reference::taylor_green_2d tg{U0, 1.0, p0};
+  s.initialize_averaged([&](const Eigen::Vector3d& x) { return tg(x[0], x[1]); }, 4);
   const double ke0 = kinetic_energy(s);
   pft::run_to(s, t_end, 0.5);
   const double rate = -std::log(kinetic_energy(s) / ke0) / (4 * t_end);

@@ -18,6 +18,7 @@
 #include "grid.hpp"
 #include "reconstruction/first_order.hpp"
 #include "reconstruction/muscl.hpp"
+#include "reference/vortices.hpp"
 #include "solver.hpp"
 #include "state.hpp"
 #include "turbulence/none.hpp"

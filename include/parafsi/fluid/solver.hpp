@@ -111,6 +111,7 @@ struct totals {
   double mass = 0;
   std::array<double, 3> momentum{};
   double energy = 0;
+  double kinetic = 0;  ///< kinetic energy ½ ρ|u|² integrated (J)
 };
 
 template <class Flux = flux::hllc_lm, class Recon = recon::muscl<limiter::van_leer>,
@@ -320,6 +321,7 @@ class solver {
           t.momentum[1] += q.m.y * vol;
           t.momentum[2] += q.m.z * vol;
           t.energy += q.E * vol;
+          t.kinetic += 0.5 * dot(q.m, q.m) / q.rho * vol;
         }
     return t;
   }

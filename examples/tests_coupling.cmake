@@ -1,0 +1,87 @@
+# Smoke tests of the coupling example programs (included from examples/CMakeLists.txt
+# when tests are on): piston, porous_screen and leak_box run briefly with each coupling
+# they accept, print their key=value result, write a CSV with the exact header and at
+# least one data row; bad flags fail. Total run time: a few seconds.
+
+set(_cpl_out ${CMAKE_CURRENT_BINARY_DIR}/test_output_coupling)
+file(MAKE_DIRECTORY ${_cpl_out})
+
+# Helper script: run PROGRAM ARGS (| separated) [--out OUT], require exit code 0, the
+# output to match EXPECT and, when HEADER is set, OUT's first line to equal HEADER
+# with at least one data row.
+set(_cpl_check ${CMAKE_CURRENT_BINARY_DIR}/run_coupling_example.cmake)
+file(WRITE ${_cpl_check} [=[
+string(REPLACE "|" ";" ARGS "${ARGS}")
+if(DEFINED OUT)
+  file(REMOVE ${OUT})
+  list(APPEND ARGS --out ${OUT})
+endif()
+execute_process(COMMAND ${PROGRAM} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${PROGRAM} exited with ${rc}:\n${err}")
+endif()
+if(NOT out MATCHES "${EXPECT}")
+  message(FATAL_ERROR "output does not match '${EXPECT}'")
+endif()
+if(DEFINED HEADER AND NOT HEADER STREQUAL "")
+  file(STRINGS ${OUT} lines)
+  list(LENGTH lines n)
+  list(GET lines 0 first)
+  if(NOT first STREQUAL HEADER)
+    message(FATAL_ERROR "${OUT}: header '${first}', expected '${HEADER}'")
+  endif()
+  if(n LESS 2)
+    message(FATAL_ERROR "${OUT}: no data rows")
+  endif()
+endif()
+]=])
+
+# parafsi_coupling_example(NAME PROGRAM HEADER EXPECT args...); HEADER "" = no --out.
+function(parafsi_coupling_example name program header expect)
+  list(JOIN ARGN "|" _args)
+  set(_out "")
+  if(NOT header STREQUAL "")
+    set(_out -DOUT=${_cpl_out}/${name}.csv)
+  endif()
+  add_test(NAME ${name}
+    COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:${program}> "-DARGS=${_args}" ${_out} "-DHEADER=${header}"
+            "-DEXPECT=${expect}" -P ${_cpl_check})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 120 LABELS "examples;coupling" ENVIRONMENT "OMP_NUM_THREADS=1")
+endfunction()
+
+function(parafsi_coupling_example_fails name program)
+  add_test(NAME ${name} COMMAND ${program} ${ARGN})
+  set_tests_properties(${name} PROPERTIES WILL_FAIL TRUE TIMEOUT 60 LABELS "examples;coupling")
+endfunction()
+
+# ---- piston (penalty): short run on the default duct.
+if(TARGET piston)
+  parafsi_coupling_example(example_coupling_piston piston "" "pressure_rise=.*rho_c_v=" --time 0.002)
+  parafsi_coupling_example_fails(example_coupling_piston_bad_velocity piston --velocity -1)
+endif()
+
+# ---- porous_screen and leak_box with both couplings (coarse, short).
+foreach(c IN ITEMS penalty embedded)
+  parafsi_coupling_example(example_coupling_porous_screen_${c} porous_screen "t,pressure_drop,through_velocity"
+    "pressure_drop=[0-9.e+-]+ through_velocity=" --coupling ${c} --fabric mat509 --velocity 1 --cells 20 --time 0.01
+    --quiet)
+  parafsi_coupling_example(example_coupling_leak_box_${c} leak_box "t,pressure_left,pressure_right,leak_velocity"
+    "leak_velocity=" --coupling ${c} --pressure-jump 50 --cells 20 --time 0.005 --quiet)
+endforeach()
+parafsi_coupling_example(example_coupling_leak_box_embedded_zero leak_box "t,pressure_left,pressure_right,leak_velocity"
+  "leak_velocity=0 " --coupling embedded --pressure-jump 50 --cells 20 --time 0.005 --quiet)
+parafsi_coupling_example_fails(example_coupling_porous_screen_bad_coupling porous_screen --coupling foo
+  --out ${_cpl_out}/unused.csv)
+parafsi_coupling_example_fails(example_coupling_porous_screen_bad_fabric porous_screen --fabric silk
+  --out ${_cpl_out}/unused.csv)
+parafsi_coupling_example_fails(example_coupling_leak_box_bad_jump leak_box --pressure-jump -5
+  --out ${_cpl_out}/unused.csv)
+
+# ---- bluff_body_drag (when built).
+if(TARGET bluff_body_drag)
+  foreach(shape IN ITEMS disk cup)
+    parafsi_coupling_example(example_coupling_bluff_${shape} bluff_body_drag "t,drag_coefficient"
+      "drag_coefficient=" --shape ${shape} --coupling embedded --cells 16 --time 0.02 --quiet)
+  endforeach()
+endif()

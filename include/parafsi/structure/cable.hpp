@@ -24,9 +24,8 @@
 
 #include "../core/error.hpp"
 #include "../core/simd.hpp"
-#include "../core/simd_gather.hpp"
 #include "../core/vec3.hpp"
-#include "detail/scatter.hpp"
+#include "detail/corner_forces.hpp"
 #include "material/cable.hpp"
 #include "nodes.hpp"
 
@@ -88,13 +87,7 @@ class cable {
       nd.add_mass(s[0], 0.5 * rl * L0);
       nd.add_mass(s[1], 0.5 * rl * L0);
     }
-    std::array<std::vector<index_t>, 2> cn;
-    for (int a = 0; a < 2; ++a) cn[std::size_t(a)].assign(conn_[std::size_t(a)].begin(), conn_[std::size_t(a)].begin() + n_);
-    scatter_.build(cn, n_, np_, N);
-    f_.resize(std::size_t(2 * np_ + simd::width));
-    fd_.resize(std::size_t(2 * np_ + simd::width));
-    fe_.resize(std::size_t(2 * np_ + simd::width));
-    energy_part_.assign(std::size_t(impl::chunk_count(n_)), 0.0);
+    out_.build(conn_, n_, np_, N);
   }
   /// After all masses are known: damping coefficients from the effective end mass.
   void post_finalize(const nodes& nd) {
@@ -122,28 +115,16 @@ class cable {
 
   template <bool Track, bool Vectorize = true>
   void compute_forces(const node_kinematics& k) {
-    impl::for_each_chunk(n_, [&](index_t begin, index_t end, index_t c) {
-      double acc = 0;
-      auto body = [&](auto tag, index_t e) {
-        using V = typename decltype(tag)::type;
-        const V w = kernel<V, Track>(k, e);
-        if constexpr (Track) acc += simd::hsum(w);
-      };
-      if constexpr (Vectorize) simd::for_each_pack(begin, end, body);
-      else simd::for_each_scalar(begin, end, body);
-      if constexpr (Track) energy_part_[std::size_t(c)] = acc;
+    impl::for_each_element<Track, Vectorize>(n_, std::array{&out_.energy_part}, [&](auto tag, index_t e) {
+      using V = typename decltype(tag)::type;
+      return std::array{kernel<V, Track>(k, e)};
     });
   }
   template <bool Track>
-  void scatter(nodes& nd) const { scatter_.scatter<Track>(nd, f_, fd_, fe_); }
-  double strain_energy() const { return impl::ordered_sum(energy_part_); }
+  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
+  double strain_energy() const { return out_.strain_energy(); }
 
-  index_t first_bad_element() const {
-    for (index_t e = 0; e < n_; ++e)
-      for (index_t c = 0; c < 2; ++c)
-        if (!f_.finite_at(std::size_t(c * np_ + e))) return e;
-    return -1;
-  }
+  index_t first_bad_element() const { return out_.first_bad_element(); }
   /// Current tension of element e (N), elastic + damping, from positions and velocities.
   double tension(const nodes& nd, index_t e) const {
     const index_t a = conn_[0][std::size_t(e)], b = conn_[1][std::size_t(e)];
@@ -161,10 +142,8 @@ class cable {
   template <class V, bool Track>
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e) {
     const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e;
-    const vec3<V> x0{simd::gather<V>(k.x, i0), simd::gather<V>(k.y, i0), simd::gather<V>(k.z, i0)};
-    const vec3<V> x1{simd::gather<V>(k.x, i1), simd::gather<V>(k.y, i1), simd::gather<V>(k.z, i1)};
-    const vec3<V> v0{simd::gather<V>(k.vx, i0), simd::gather<V>(k.vy, i0), simd::gather<V>(k.vz, i0)};
-    const vec3<V> v1{simd::gather<V>(k.vx, i1), simd::gather<V>(k.vy, i1), simd::gather<V>(k.vz, i1)};
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1);
+    const vec3<V> v0 = impl::gather_velocity<V>(k, i0), v1 = impl::gather_velocity<V>(k, i1);
     const V L0 = simd::load<V>(L0_.data() + e), kk = simd::load<V>(k_.data() + e), cd = simd::load<V>(cd_.data() + e);
     // Step 1. Geometry and elongation rate.
     const vec3<V> d = x1 - x0;
@@ -178,25 +157,18 @@ class cable {
     // Step 3. Corner forces.
     const vec3<V> f = u * Tt;
     const vec3<V> zero{V(0.0), V(0.0), V(0.0)};
-    store_corner<V>(f_, 0, e, f);
-    store_corner<V>(f_, 1, e, zero - f);
+    out_.store<V>(out_.total, 0, e, f);
+    out_.store<V>(out_.total, 1, e, zero - f);
     if constexpr (Track) {
       const vec3<V> fd = u * (Tt - Te);
-      store_corner<V>(fd_, 0, e, fd);
-      store_corner<V>(fd_, 1, e, zero - fd);
-      store_corner<V>(fe_, 0, e, zero);
-      store_corner<V>(fe_, 1, e, zero);
+      out_.store<V>(out_.damping, 0, e, fd);
+      out_.store<V>(out_.damping, 1, e, zero - fd);
+      out_.store<V>(out_.external, 0, e, zero);
+      out_.store<V>(out_.external, 1, e, zero);
       return V(0.5) * Te * Te / simd::max(kk, V(1e-300));
     } else {
       return V(0.0);
     }
-  }
-  template <class V>
-  PARAFSI_INLINE void store_corner(impl::corner_buffer& b, index_t c, index_t e, const vec3<V>& f) const {
-    const std::size_t s = std::size_t(c * np_ + e);
-    simd::store(b.x.data() + s, f.x);
-    simd::store(b.y.data() + s, f.y);
-    simd::store(b.z.data() + s, f.z);
   }
 
   line_mesh mesh_;
@@ -204,9 +176,7 @@ class cable {
   index_t n_ = 0, np_ = 0;
   std::array<simd::aligned_vector<index_t>, 2> conn_;
   simd::aligned_vector<double> L0_, k_, cd_;
-  impl::corner_buffer f_, fd_, fe_;
-  impl::corner_scatter scatter_;
-  std::vector<double> energy_part_;
+  impl::corner_forces<2> out_;
 };
 
 }  // namespace parafsi::structure

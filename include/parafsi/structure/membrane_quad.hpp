@@ -64,7 +64,9 @@
 ///
 /// Kernel: one pointwise body on V = double or simd::pack<double> (core/simd.hpp), node
 /// data gathered by index, corner forces written to a per-element buffer and gathered
-/// per node (detail/scatter.hpp): race-free and thread-count independent.
+/// per node (detail/corner_forces.hpp, detail/scatter.hpp): race-free and thread-count
+/// independent. Stress, damping, energy, time-step, load and set-up pieces shared with
+/// membrane_tri.hpp are in detail/membrane_common.hpp.
 ///
 /// References: Belytschko T., Lin J.I., Tsay C.-S. (1984) CMAME 42:225–251;
 ///   Flanagan D.P., Belytschko T. (1981) IJNME 17:679–706;
@@ -85,9 +87,9 @@
 
 #include "../core/error.hpp"
 #include "../core/simd.hpp"
-#include "../core/simd_gather.hpp"
 #include "../core/vec3.hpp"
-#include "detail/scatter.hpp"
+#include "detail/corner_forces.hpp"
+#include "detail/membrane_common.hpp"
 #include "material/fabric.hpp"
 #include "nodes.hpp"
 
@@ -121,19 +123,14 @@ class membrane_quad {
   membrane_quad(quad_mesh mesh, Fabric fabric, quad_options opt = {})
       : mesh_(std::move(mesh)), mat_(fabric), opt_(opt) {
     mat_.validate();
-    require(opt_.damping_ratio >= 0 && opt_.damping_ratio < 1, "membrane_quad: damping ratio must be in [0, 1), got ",
-            opt_.damping_ratio);
-    require(opt_.min_quality >= 0 && opt_.min_quality < 1, "membrane_quad: min_quality must be in [0, 1), got ",
-            opt_.min_quality);
+    impl::check_membrane_options(name(), opt_.damping_ratio, opt_.min_quality);
     require(opt_.hourglass_stiffness >= 0 && opt_.hourglass_stiffness <= 1,
             "membrane_quad: hourglass_stiffness must be in [0, 1], got ", opt_.hourglass_stiffness);
     require(opt_.hourglass_viscosity >= 0 && opt_.hourglass_viscosity <= 1,
             "membrane_quad: hourglass_viscosity must be in [0, 1], got ", opt_.hourglass_viscosity);
     require(opt_.hourglass_out_of_plane >= 0 && opt_.hourglass_out_of_plane <= 10,
             "membrane_quad: hourglass_out_of_plane must be in [0, 10], got ", opt_.hourglass_out_of_plane);
-    require(mesh_.warp_per_element.empty() || mesh_.warp_per_element.size() == mesh_.quads.size(),
-            "membrane_quad: warp_per_element has ", mesh_.warp_per_element.size(), " entries for ",
-            mesh_.quads.size(), " quads");
+    impl::check_warp_count(name(), mesh_.warp_per_element.size(), mesh_.quads.size(), "quads");
     q_ = mat_.moduli();
     n_ = index_t(mesh_.quads.size());
     np_ = index_t(simd::padded(std::size_t(n_)));
@@ -147,18 +144,9 @@ class membrane_quad {
 
   // ---------------------------------------------------------------- loads
   /// Uniform pressure on every element (Pa).
-  void set_pressure(double p) {
-    require(std::isfinite(p), "membrane_quad::set_pressure: non-finite pressure ", p);
-    std::fill(p_.begin(), p_.end(), p);
-  }
+  void set_pressure(double p) { impl::set_uniform_pressure(name(), p_, p); }
   /// Per-element pressure (Pa), one value per quad.
-  void set_pressure(std::span<const double> p) {
-    require(index_t(p.size()) == n_, "membrane_quad::set_pressure: got ", p.size(), " values for ", n_, " elements");
-    for (index_t e = 0; e < n_; ++e) {
-      require(std::isfinite(p[std::size_t(e)]), "membrane_quad::set_pressure: non-finite pressure at element ", e);
-      p_[std::size_t(e)] = p[std::size_t(e)];
-    }
-  }
+  void set_pressure(std::span<const double> p) { impl::set_element_pressure(name(), p_, n_, p); }
   double* pressure() noexcept { return p_.data(); }
 
   // ---------------------------------------------------------------- set-up
@@ -178,18 +166,12 @@ class membrane_quad {
     gbc_.assign(pad, 0.0);
     gcc_.assign(pad, 0.0);
     lc0_.assign(std::size_t(n_), 0.0);
-    if (mesh_.reference.empty()) auto_reference_ = true;
-    if (auto_reference_)
-      for (index_t i = index_t(mesh_.reference.size()); i < N; ++i) mesh_.reference.push_back(nd.position(i));
-    require(index_t(mesh_.reference.size()) == N, "membrane_quad: reference has ", mesh_.reference.size(),
-            " positions for ", N, " nodes");
+    impl::complete_reference(name(), mesh_.reference, auto_reference_, nd);
     const double rhoA = mat_.areal_density, Qmax = std::max(q_.Q11, q_.Q22), t = mat_.thickness;
     double lc_min = std::numeric_limits<double>::infinity();
     for (index_t e = 0; e < n_; ++e) {
       const auto& qd = mesh_.quads[std::size_t(e)];
-      for (int a = 0; a < 4; ++a)
-        require(qd[std::size_t(a)] >= 0 && qd[std::size_t(a)] < N, "membrane_quad: element ", e, " names node ",
-                qd[std::size_t(a)], " outside [0, ", N, ")");
+      impl::check_element_nodes(name(), e, qd, N);
       for (int a = 0; a < 4; ++a)
         for (int b = a + 1; b < 4; ++b)
           require(qd[std::size_t(a)] != qd[std::size_t(b)], "membrane_quad: element ", e, " repeats node ",
@@ -205,10 +187,8 @@ class membrane_quad {
       const Eigen::Vector3d Nn = n0 / A2;
       const Eigen::Vector3d Xc = 0.25 * (X[0] + X[1] + X[2] + X[3]);
       double xh[4], yh[4], zh[4];
-      Eigen::Vector3d d = mesh_.warp_per_element.empty() ? mesh_.warp : mesh_.warp_per_element[std::size_t(e)];
-      d -= d.dot(Nn) * Nn;
-      if (d.norm() < 1e-6) d = (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn;  // warp normal to the element
-      const Eigen::Vector3d E1 = d.normalized(), E2 = Nn.cross(E1);
+      // Warp normal to the element: fall back to edge 0→1 projected on it.
+      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(mesh_, e), (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn);
       for (int a = 0; a < 4; ++a) {
         xh[a] = (X[std::size_t(a)] - Xc).dot(E1);
         yh[a] = (X[std::size_t(a)] - Xc).dot(E2);
@@ -263,14 +243,8 @@ class membrane_quad {
       lc0_[std::size_t(e)] = A0 / lmax;
       lc_min = std::min(lc_min, A0 / lmax);
     }
-    beta_ = n_ > 0 ? opt_.damping_ratio * lc_min / mat_.wave_speed() : 0.0;
-    std::array<std::vector<index_t>, 4> cn;
-    for (int a = 0; a < 4; ++a) cn[std::size_t(a)].assign(conn_[std::size_t(a)].begin(), conn_[std::size_t(a)].begin() + n_);
-    scatter_.build(cn, n_, np_, N);
-    f_.resize(std::size_t(4 * np_ + simd::width));
-    fd_.resize(std::size_t(4 * np_ + simd::width));
-    fe_.resize(std::size_t(4 * np_ + simd::width));
-    energy_part_.assign(std::size_t(impl::chunk_count(n_)), 0.0);
+    beta_ = impl::stiffness_damping(n_, opt_.damping_ratio, lc_min, mat_.wave_speed());
+    out_.build(conn_, n_, np_, N);
     hg_part_.assign(std::size_t(impl::chunk_count(n_)), 0.0);
   }
 
@@ -283,10 +257,10 @@ class membrane_quad {
     else run<Track, false, Vectorize>(k);
   }
   template <bool Track>
-  void scatter(nodes& nd) const { scatter_.scatter<Track>(nd, f_, fd_, fe_); }
+  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
 
   /// Strain energy Σ [A0 t ½ S:E + U_hg] from the last tracked evaluation (J).
-  double strain_energy() const { return impl::ordered_sum(energy_part_); }
+  double strain_energy() const { return out_.strain_energy(); }
   /// The hourglass part Σ U_hg of strain_energy() (J).
   double hourglass_energy() const { return impl::ordered_sum(hg_part_); }
 
@@ -294,35 +268,24 @@ class membrane_quad {
   /// and the hourglass spring's share √(1 + r_hg).
   double critical_dt(const nodes& nd) const {
     const node_kinematics k = nd.kinematics();
-    double rate = 0;
-    for (index_t e = 0; e < n_; ++e) {
+    const double rate = impl::stretch_rate(n_, lc0_, [&](index_t e, double& E11, double& E22, double& E12) {
       vec3<double> F1, F2;
-      double E11, E22, E12;
       strains<double>(k, e, F1, F2, E11, E22, E12);
-      const double C11 = 1 + 2 * E11, C22 = 1 + 2 * E22, C12 = 2 * E12;
-      const double l2 = 0.5 * (C11 + C22) + std::sqrt(0.25 * (C11 - C22) * (C11 - C22) + C12 * C12);
-      rate = std::max(rate, std::sqrt(std::max(1.0, l2)) / lc0_[std::size_t(e)]);
-    }
-    const double z = opt_.damping_ratio;
-    rate *= std::sqrt(1.0 + opt_.hourglass_stiffness);
-    return rate > 0 ? (std::sqrt(1.0 + z * z) - z) / (rate * mat_.wave_speed())
-                    : std::numeric_limits<double>::infinity();
+    });
+    return impl::membrane_step(rate * std::sqrt(1.0 + opt_.hourglass_stiffness), opt_.damping_ratio,
+                               mat_.wave_speed());
   }
 
   /// First element with a non-finite corner force (-1 if none), for failure reports.
-  index_t first_bad_element() const {
-    for (index_t e = 0; e < n_; ++e)
-      for (index_t c = 0; c < 4; ++c)
-        if (!f_.finite_at(std::size_t(c * np_ + e))) return e;
-    return -1;
-  }
+  index_t first_bad_element() const { return out_.first_bad_element(); }
   /// Green–Lagrange strain (E11, E22, 2E12) and filtered elastic stress (S11, S22, S12)
   /// at the centre of element e in its fibre axes, for output and tests.
   std::array<double, 6> strain_stress(const nodes& nd, index_t e) const {
     const node_kinematics k = nd.kinematics();
     vec3<double> F1, F2;
-    double E11, E22, E12, D11 = 0, D22 = 0, D12 = 0;
+    double E11, E22, E12;
     strains<double>(k, e, F1, F2, E11, E22, E12);
+    double D11 = 0, D22 = 0, D12 = 0;
     double S11 = q_.Q11 * E11 + q_.Q12 * E22, S22 = q_.Q12 * E11 + q_.Q22 * E22, S12 = 2.0 * q_.Q66 * E12;
     mat_.wrinkling.apply(S11, S22, S12, D11, D22, D12, E11, E22, E12, q_);
     return {E11, E22, 2.0 * E12, S11, S22, S12};
@@ -349,17 +312,11 @@ class membrane_quad {
  private:
   template <bool Track, bool Damped, bool Vectorize>
   void run(const node_kinematics& k) {
-    impl::for_each_chunk(n_, [&](index_t begin, index_t end, index_t c) {
-      double acc = 0, acc_hg = 0;
-      auto body = [&](auto tag, index_t e) {
-        using V = typename decltype(tag)::type;
-        V hg(0.0);
-        const V w = kernel<V, Track, Damped>(k, e, hg);
-        if constexpr (Track) { acc += simd::hsum(w); acc_hg += simd::hsum(hg); }
-      };
-      if constexpr (Vectorize) simd::for_each_pack(begin, end, body);
-      else simd::for_each_scalar(begin, end, body);
-      if constexpr (Track) { energy_part_[std::size_t(c)] = acc; hg_part_[std::size_t(c)] = acc_hg; }
+    impl::for_each_element<Track, Vectorize>(n_, std::array{&out_.energy_part, &hg_part_}, [&](auto tag, index_t e) {
+      using V = typename decltype(tag)::type;
+      V hg(0.0);
+      const V w = kernel<V, Track, Damped>(k, e, hg);
+      return std::array{w, hg};
     });
   }
 
@@ -372,7 +329,7 @@ class membrane_quad {
     vec3<V> x[4], qh = F1;
     for (int a = 0; a < 4; ++a) {
       const index_t* ia = conn_[std::size_t(a)].data() + e;
-      x[a] = {simd::gather<V>(k.x, ia), simd::gather<V>(k.y, ia), simd::gather<V>(k.z, ia)};
+      x[a] = impl::gather_position<V>(k, ia);
       F1 += x[a] * simd::load<V>(ref_[std::size_t(a)].data() + e);
       F2 += x[a] * simd::load<V>(ref_[std::size_t(4 + a)].data() + e);
       qh += x[a] * simd::load<V>(gam_[std::size_t(a)].data() + e);
@@ -392,10 +349,8 @@ class membrane_quad {
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e, V& hg) {
     const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e;
     const index_t* i2 = conn_[2].data() + e; const index_t* i3 = conn_[3].data() + e;
-    const vec3<V> x0{simd::gather<V>(k.x, i0), simd::gather<V>(k.y, i0), simd::gather<V>(k.z, i0)};
-    const vec3<V> x1{simd::gather<V>(k.x, i1), simd::gather<V>(k.y, i1), simd::gather<V>(k.z, i1)};
-    const vec3<V> x2{simd::gather<V>(k.x, i2), simd::gather<V>(k.y, i2), simd::gather<V>(k.z, i2)};
-    const vec3<V> x3{simd::gather<V>(k.x, i3), simd::gather<V>(k.y, i3), simd::gather<V>(k.z, i3)};
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1);
+    const vec3<V> x2 = impl::gather_position<V>(k, i2), x3 = impl::gather_position<V>(k, i3);
     const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e);
     const V b2 = simd::load<V>(ref_[2].data() + e), b3 = simd::load<V>(ref_[3].data() + e);
     const V c0 = simd::load<V>(ref_[4].data() + e), c1 = simd::load<V>(ref_[5].data() + e);
@@ -423,17 +378,14 @@ class membrane_quad {
     const V E22 = V(0.5) * (dot(F2, F2) - V(1.0)) + dn2 * Gc;
     const V E12 = V(0.5) * dot(F1, F2) + dn2 * Gx;
     // Step 3. Elastic second Piola–Kirchhoff stress (Eq. 4).
-    V S11 = V(q_.Q11) * E11 + V(q_.Q12) * E22;
-    V S22 = V(q_.Q12) * E11 + V(q_.Q22) * E22;
-    V S12 = V(2.0 * q_.Q66) * E12;
+    V S11, S22, S12;
+    impl::elastic_stress(q_, E11, E22, E12, S11, S22, S12);
     // Step 4. Stiffness-proportional viscous stress β Q Ė; hourglass damping.
     V D11(0.0), D22(0.0), D12(0.0);
     vec3<V> Qd{V(0.0), V(0.0), V(0.0)};
     if constexpr (Damped) {
-      const vec3<V> v0{simd::gather<V>(k.vx, i0), simd::gather<V>(k.vy, i0), simd::gather<V>(k.vz, i0)};
-      const vec3<V> v1{simd::gather<V>(k.vx, i1), simd::gather<V>(k.vy, i1), simd::gather<V>(k.vz, i1)};
-      const vec3<V> v2{simd::gather<V>(k.vx, i2), simd::gather<V>(k.vy, i2), simd::gather<V>(k.vz, i2)};
-      const vec3<V> v3{simd::gather<V>(k.vx, i3), simd::gather<V>(k.vy, i3), simd::gather<V>(k.vz, i3)};
+      const vec3<V> v0 = impl::gather_velocity<V>(k, i0), v1 = impl::gather_velocity<V>(k, i1);
+      const vec3<V> v2 = impl::gather_velocity<V>(k, i2), v3 = impl::gather_velocity<V>(k, i3);
       const vec3<V> G1 = v0 * b0 + v1 * b1 + v2 * b2 + v3 * b3;
       const vec3<V> G2 = v0 * c0 + v1 * c1 + v2 * c2 + v3 * c3;
       const vec3<V> qd = v0 * g0 + v1 * g1 + v2 * g2 + v3 * g3;
@@ -442,9 +394,7 @@ class membrane_quad {
       const V R11 = dot(F1, G1) + r2 * Gb, R22 = dot(F2, G2) + r2 * Gc;
       const V R12 = V(0.5) * (dot(F1, G2) + dot(F2, G1)) + r2 * Gx;
       const V bt(beta_);
-      D11 = bt * (V(q_.Q11) * R11 + V(q_.Q12) * R22);
-      D22 = bt * (V(q_.Q12) * R11 + V(q_.Q22) * R22);
-      D12 = bt * V(2.0 * q_.Q66) * R12;
+      impl::viscous_stress(q_, bt, R11, R22, R12, D11, D22, D12);
       Qd = (F1 * dot(F1, qd) + F2 * dot(F2, qd)) * (bt * km) + qd * simd::load<V>(cv_.data() + e);
     }
     // Step 5. Wrinkling (no compression).
@@ -464,35 +414,27 @@ class membrane_quad {
     const vec3<V> r2 = cross(d2, wq), r3 = cross(wq, d1);
     const V sn = Qw;
     const vec3<V> fp = n * (simd::load<V>(p_.data() + e) * V(0.125));
-    store_corner<V>(f_, 0, e, fp - (P1 * b0 + P2 * c0 + QT * g0 - r2 * sn));
-    store_corner<V>(f_, 1, e, fp - (P1 * b1 + P2 * c1 + QT * g1 - r3 * sn));
-    store_corner<V>(f_, 2, e, fp - (P1 * b2 + P2 * c2 + QT * g2 + r2 * sn));
-    store_corner<V>(f_, 3, e, fp - (P1 * b3 + P2 * c3 + QT * g3 + r3 * sn));
+    out_.store<V>(out_.total, 0, e, fp - (P1 * b0 + P2 * c0 + QT * g0 - r2 * sn));
+    out_.store<V>(out_.total, 1, e, fp - (P1 * b1 + P2 * c1 + QT * g1 - r3 * sn));
+    out_.store<V>(out_.total, 2, e, fp - (P1 * b2 + P2 * c2 + QT * g2 + r2 * sn));
+    out_.store<V>(out_.total, 3, e, fp - (P1 * b3 + P2 * c3 + QT * g3 + r3 * sn));
     if constexpr (Track) {
       const vec3<V> Q1 = (F1 * D11 + F2 * D12) * at;
       const vec3<V> Q2 = (F1 * D12 + F2 * D22) * at;
       const V Qwd = V(2.0) * at * dn * (D11 * Gb + D22 * Gc + V(2.0) * D12 * Gx);
       const vec3<V> Qdt = e3 * Qwd + Qd;
       const vec3<V> zero{V(0.0), V(0.0), V(0.0)};
-      store_corner<V>(fd_, 0, e, zero - (Q1 * b0 + Q2 * c0 + Qdt * g0 - r2 * Qwd));
-      store_corner<V>(fd_, 1, e, zero - (Q1 * b1 + Q2 * c1 + Qdt * g1 - r3 * Qwd));
-      store_corner<V>(fd_, 2, e, zero - (Q1 * b2 + Q2 * c2 + Qdt * g2 + r2 * Qwd));
-      store_corner<V>(fd_, 3, e, zero - (Q1 * b3 + Q2 * c3 + Qdt * g3 + r3 * Qwd));
-      for (index_t c = 0; c < 4; ++c) store_corner<V>(fe_, c, e, fp);
+      out_.store<V>(out_.damping, 0, e, zero - (Q1 * b0 + Q2 * c0 + Qdt * g0 - r2 * Qwd));
+      out_.store<V>(out_.damping, 1, e, zero - (Q1 * b1 + Q2 * c1 + Qdt * g1 - r3 * Qwd));
+      out_.store<V>(out_.damping, 2, e, zero - (Q1 * b2 + Q2 * c2 + Qdt * g2 + r2 * Qwd));
+      out_.store<V>(out_.damping, 3, e, zero - (Q1 * b3 + Q2 * c3 + Qdt * g3 + r3 * Qwd));
+      for (index_t c = 0; c < 4; ++c) out_.store<V>(out_.external, c, e, fp);
       const V um = V(0.5) * km * (a1 * a1 + a2 * a2);
       hg = um + V(0.5) * at * dn2 * (S11 * Gb + S22 * Gc + V(2.0) * S12 * Gx);
-      return V(0.5) * at * (S11 * E11 + S22 * E22 + V(2.0) * S12 * E12) + um;
+      return impl::membrane_energy(at, S11, S22, S12, E11, E22, E12) + um;
     } else {
       return V(0.0);
     }
-  }
-
-  template <class V>
-  PARAFSI_INLINE void store_corner(impl::corner_buffer& b, index_t c, index_t e, const vec3<V>& f) const {
-    const std::size_t s = std::size_t(c * np_ + e);
-    simd::store(b.x.data() + s, f.x);
-    simd::store(b.y.data() + s, f.y);
-    simd::store(b.z.data() + s, f.z);
   }
 
   quad_mesh mesh_;
@@ -507,9 +449,8 @@ class membrane_quad {
   std::array<simd::aligned_vector<double>, 4> gam_;  // hourglass shape vectors γ_I
   simd::aligned_vector<double> a0t_, khg_, cv_, w0_, gbb_, gbc_, gcc_, p_;
   std::vector<double> lc0_;  // reference A0 / max edge
-  impl::corner_buffer f_, fd_, fe_;
-  impl::corner_scatter scatter_;
-  std::vector<double> energy_part_, hg_part_;
+  impl::corner_forces<4> out_;
+  std::vector<double> hg_part_;
 };
 
 }  // namespace parafsi::structure

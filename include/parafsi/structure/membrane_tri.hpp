@@ -21,7 +21,9 @@
 ///
 /// Kernel: one pointwise body on V = double or simd::pack<double>, node data gathered by
 /// index, corner forces written to a per-element buffer and gathered per node
-/// (detail/scatter.hpp), so threads never race and results do not depend on them.
+/// (detail/corner_forces.hpp, detail/scatter.hpp), so threads never race and results do
+/// not depend on them. Stress, damping, energy, time-step, load and set-up pieces shared
+/// with membrane_quad.hpp are in detail/membrane_common.hpp.
 ///
 /// References: Belytschko, Liu, Moran (2000) Nonlinear Finite Elements, §4.5, §5.4;
 ///   Taylor R.L., Oñate E., Ubach P.-A. (2005) Finite element analysis of membrane
@@ -40,9 +42,9 @@
 
 #include "../core/error.hpp"
 #include "../core/simd.hpp"
-#include "../core/simd_gather.hpp"
 #include "../core/vec3.hpp"
-#include "detail/scatter.hpp"
+#include "detail/corner_forces.hpp"
+#include "detail/membrane_common.hpp"
 #include "material/fabric.hpp"
 #include "nodes.hpp"
 
@@ -73,13 +75,8 @@ class membrane_tri {
   membrane_tri(triangle_mesh mesh, Fabric fabric, membrane_options opt = {})
       : mesh_(std::move(mesh)), mat_(fabric), opt_(opt) {
     mat_.validate();
-    require(opt_.damping_ratio >= 0 && opt_.damping_ratio < 1, "membrane_tri: damping ratio must be in [0, 1), got ",
-            opt_.damping_ratio);
-    require(opt_.min_quality >= 0 && opt_.min_quality < 1, "membrane_tri: min_quality must be in [0, 1), got ",
-            opt_.min_quality);
-    require(mesh_.warp_per_element.empty() || mesh_.warp_per_element.size() == mesh_.triangles.size(),
-            "membrane_tri: warp_per_element has ", mesh_.warp_per_element.size(), " entries for ",
-            mesh_.triangles.size(), " triangles");
+    impl::check_membrane_options(name(), opt_.damping_ratio, opt_.min_quality);
+    impl::check_warp_count(name(), mesh_.warp_per_element.size(), mesh_.triangles.size(), "triangles");
     q_ = mat_.moduli();
     n_ = index_t(mesh_.triangles.size());
     np_ = index_t(simd::padded(std::size_t(n_)));
@@ -92,18 +89,9 @@ class membrane_tri {
 
   // ---------------------------------------------------------------- loads
   /// Uniform pressure on every element (Pa).
-  void set_pressure(double p) {
-    require(std::isfinite(p), "membrane_tri::set_pressure: non-finite pressure ", p);
-    std::fill(p_.begin(), p_.end(), p);
-  }
+  void set_pressure(double p) { impl::set_uniform_pressure(name(), p_, p); }
   /// Per-element pressure (Pa), one value per triangle.
-  void set_pressure(std::span<const double> p) {
-    require(index_t(p.size()) == n_, "membrane_tri::set_pressure: got ", p.size(), " values for ", n_, " elements");
-    for (index_t e = 0; e < n_; ++e) {
-      require(std::isfinite(p[std::size_t(e)]), "membrane_tri::set_pressure: non-finite pressure at element ", e);
-      p_[std::size_t(e)] = p[std::size_t(e)];
-    }
-  }
+  void set_pressure(std::span<const double> p) { impl::set_element_pressure(name(), p_, n_, p); }
   double* pressure() noexcept { return p_.data(); }
 
   // ---------------------------------------------------------------- set-up
@@ -114,21 +102,13 @@ class membrane_tri {
     for (auto& a : ref_) a.assign(std::size_t(np_) + simd::width, 0.0);
     a0t_.assign(std::size_t(np_) + simd::width, 0.0);
     lc0_.assign(std::size_t(n_), 0.0);
-    // Without a given reference, the positions at the first finalize become the
-    // stress-free state (kept for later re-finalizes, e.g. after pinning a node).
-    if (mesh_.reference.empty()) auto_reference_ = true;
-    if (auto_reference_)
-      for (index_t i = index_t(mesh_.reference.size()); i < N; ++i) mesh_.reference.push_back(nd.position(i));
-    require(index_t(mesh_.reference.size()) == N, "membrane_tri: reference has ", mesh_.reference.size(),
-            " positions for ", N, " nodes");
+    impl::complete_reference(name(), mesh_.reference, auto_reference_, nd);
     auto X = [&](index_t i) { return mesh_.reference[std::size_t(i)]; };
     double lc_min = std::numeric_limits<double>::infinity();
     const double rhoA = mat_.areal_density;
     for (index_t e = 0; e < n_; ++e) {
       const auto& t = mesh_.triangles[std::size_t(e)];
-      for (int a = 0; a < 3; ++a)
-        require(t[std::size_t(a)] >= 0 && t[std::size_t(a)] < N, "membrane_tri: element ", e, " names node ",
-                t[std::size_t(a)], " outside [0, ", N, ")");
+      impl::check_element_nodes(name(), e, t, N);
       require(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "membrane_tri: element ", e, " repeats a node");
       const Eigen::Vector3d X0 = X(t[0]), X1 = X(t[1]), X2 = X(t[2]);
       const Eigen::Vector3d nrm = (X1 - X0).cross(X2 - X0);
@@ -138,10 +118,8 @@ class membrane_tri {
       require(quality >= opt_.min_quality && A2 > 0, "membrane_tri: element ", e, " (nodes ", t[0], ",", t[1], ",",
               t[2], ") is a sliver: quality 4*sqrt(3)*A/sum(l^2) = ", quality, " < min_quality ", opt_.min_quality);
       const Eigen::Vector3d Nn = nrm / A2;
-      Eigen::Vector3d d = mesh_.warp_per_element.empty() ? mesh_.warp : mesh_.warp_per_element[std::size_t(e)];
-      d -= d.dot(Nn) * Nn;
-      if (d.norm() < 1e-6) d = X1 - X0;  // warp normal to the element: fall back to edge 0→1
-      const Eigen::Vector3d E1 = d.normalized(), E2 = Nn.cross(E1);
+      // Warp normal to the element: fall back to edge 0→1.
+      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(mesh_, e), X1 - X0);
       const std::array<Eigen::Vector3d, 3> Xs{X0, X1, X2};
       double xh[3], yh[3];
       for (int a = 0; a < 3; ++a) {
@@ -160,14 +138,8 @@ class membrane_tri {
       lc_min = std::min(lc_min, A2 / lmax);
       lc0_[std::size_t(e)] = A2 / lmax;
     }
-    beta_ = n_ > 0 ? opt_.damping_ratio * lc_min / mat_.wave_speed() : 0.0;
-    std::array<std::vector<index_t>, 3> cn;
-    for (int a = 0; a < 3; ++a) cn[std::size_t(a)].assign(conn_[std::size_t(a)].begin(), conn_[std::size_t(a)].begin() + n_);
-    scatter_.build(cn, n_, np_, N);
-    f_.resize(std::size_t(3 * np_ + simd::width));
-    fd_.resize(std::size_t(3 * np_ + simd::width));
-    fe_.resize(std::size_t(3 * np_ + simd::width));
-    energy_part_.assign(std::size_t(impl::chunk_count(n_)), 0.0);
+    beta_ = impl::stiffness_damping(n_, opt_.damping_ratio, lc_min, mat_.wave_speed());
+    out_.build(conn_, n_, np_, N);
   }
 
   // ---------------------------------------------------------------- forces
@@ -179,10 +151,10 @@ class membrane_tri {
     else run<Track, false, Vectorize>(k);
   }
   template <bool Track>
-  void scatter(nodes& nd) const { scatter_.scatter<Track>(nd, f_, fd_, fe_); }
+  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
 
   /// Strain energy Σ A0 t ½ S:E (filtered S) from the last tracked evaluation (J).
-  double strain_energy() const { return impl::ordered_sum(energy_part_); }
+  double strain_energy() const { return out_.strain_energy(); }
 
   /// Stable step of the part (s): Δt_e = (√(1+ζ²) − ζ) · L_c0 / (c · max(1, λ_max)), L_c0 = 2A0/max
   /// edge of the reference triangle and λ_max the largest principal stretch now. In the
@@ -191,34 +163,22 @@ class membrane_tri {
   /// step as a current-altitude estimate would (it may have zero current area).
   double critical_dt(const nodes& nd) const {
     const node_kinematics k = nd.kinematics();
-    double rate = 0;  // max λ_max / L_c0
-    for (index_t e = 0; e < n_; ++e) {
+    const double rate = impl::stretch_rate(n_, lc0_, [&](index_t e, double& E11, double& E22, double& E12) {
       vec3<double> F1, F2;
-      double E11, E22, E12;
       strains<double>(k, e, F1, F2, E11, E22, E12);
-      const double C11 = 1 + 2 * E11, C22 = 1 + 2 * E22, C12 = 2 * E12;
-      const double l2 = 0.5 * (C11 + C22) + std::sqrt(0.25 * (C11 - C22) * (C11 - C22) + C12 * C12);
-      rate = std::max(rate, std::sqrt(std::max(1.0, l2)) / lc0_[std::size_t(e)]);
-    }
-    const double z = opt_.damping_ratio;
-    return rate > 0 ? (std::sqrt(1.0 + z * z) - z) / (rate * mat_.wave_speed())
-                    : std::numeric_limits<double>::infinity();
+    });  // max λ_max / L_c0
+    return impl::membrane_step(rate, opt_.damping_ratio, mat_.wave_speed());
   }
 
   /// First element with a non-finite corner force (-1 if none), for failure reports.
-  index_t first_bad_element() const {
-    for (index_t e = 0; e < n_; ++e)
-      for (index_t c = 0; c < 3; ++c)
-        if (!f_.finite_at(std::size_t(c * np_ + e))) return e;
-    return -1;
-  }
+  index_t first_bad_element() const { return out_.first_bad_element(); }
   /// Green–Lagrange strain (E11, E22, 2E12) and filtered elastic stress (S11, S22, S12)
   /// of element e in its fibre axes, for output and tests.
   std::array<double, 6> strain_stress(const nodes& nd, index_t e) const {
-    std::array<double, 6> out{};
-    const node_kinematics k = nd.kinematics();
-    element_state<double, false>(k, e, out.data());
-    return out;
+    vec3<double> F1, F2;
+    double E11, E22, E12;
+    strains<double>(nd.kinematics(), e, F1, F2, E11, E22, E12);
+    return impl::strain_stress_of(mat_, q_, E11, E22, E12);
   }
   std::array<index_t, 3> element(index_t e) const {
     return {conn_[0][std::size_t(e)], conn_[1][std::size_t(e)], conn_[2][std::size_t(e)]};
@@ -228,39 +188,17 @@ class membrane_tri {
  private:
   template <bool Track, bool Damped, bool Vectorize>
   void run(const node_kinematics& k) {
-    impl::for_each_chunk(n_, [&](index_t begin, index_t end, index_t c) {
-      double acc = 0;
-      auto body = [&](auto tag, index_t e) {
-        using V = typename decltype(tag)::type;
-        const V w = kernel<V, Track, Damped>(k, e);
-        if constexpr (Track) acc += simd::hsum(w);
-      };
-      if constexpr (Vectorize) simd::for_each_pack(begin, end, body);
-      else simd::for_each_scalar(begin, end, body);
-      if constexpr (Track) energy_part_[std::size_t(c)] = acc;
+    impl::for_each_element<Track, Vectorize>(n_, std::array{&out_.energy_part}, [&](auto tag, index_t e) {
+      using V = typename decltype(tag)::type;
+      return std::array{kernel<V, Track, Damped>(k, e)};
     });
-  }
-
-  /// Elastic state of one element: writes E11, E22, 2E12, S11, S22, S12 (no damping).
-  template <class V, bool Damped>
-  void element_state(const node_kinematics& k, index_t e, double* out) const {
-    V E11, E22, E12, S11, S22, S12, D11(0.0), D22(0.0), D12(0.0);
-    vec3<V> F1, F2;
-    strains<V>(k, e, F1, F2, E11, E22, E12);
-    S11 = V(q_.Q11) * E11 + V(q_.Q12) * E22;
-    S22 = V(q_.Q12) * E11 + V(q_.Q22) * E22;
-    S12 = V(2.0 * q_.Q66) * E12;
-    mat_.wrinkling.apply(S11, S22, S12, D11, D22, D12, E11, E22, E12, q_);
-    out[0] = E11; out[1] = E22; out[2] = 2.0 * E12; out[3] = S11; out[4] = S22; out[5] = S12;
   }
 
   template <class V>
   PARAFSI_INLINE void strains(const node_kinematics& k, index_t e, vec3<V>& F1, vec3<V>& F2, V& E11, V& E22,
                               V& E12) const {
     const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e; const index_t* i2 = conn_[2].data() + e;
-    const vec3<V> x0{simd::gather<V>(k.x, i0), simd::gather<V>(k.y, i0), simd::gather<V>(k.z, i0)};
-    const vec3<V> x1{simd::gather<V>(k.x, i1), simd::gather<V>(k.y, i1), simd::gather<V>(k.z, i1)};
-    const vec3<V> x2{simd::gather<V>(k.x, i2), simd::gather<V>(k.y, i2), simd::gather<V>(k.z, i2)};
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1), x2 = impl::gather_position<V>(k, i2);
     const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e), b2 = simd::load<V>(ref_[2].data() + e);
     const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e), c2 = simd::load<V>(ref_[5].data() + e);
     F1 = x0 * b0 + x1 * b1 + x2 * b2;
@@ -275,9 +213,7 @@ class membrane_tri {
   template <class V, bool Track, bool Damped>
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e) {
     const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e; const index_t* i2 = conn_[2].data() + e;
-    const vec3<V> x0{simd::gather<V>(k.x, i0), simd::gather<V>(k.y, i0), simd::gather<V>(k.z, i0)};
-    const vec3<V> x1{simd::gather<V>(k.x, i1), simd::gather<V>(k.y, i1), simd::gather<V>(k.z, i1)};
-    const vec3<V> x2{simd::gather<V>(k.x, i2), simd::gather<V>(k.y, i2), simd::gather<V>(k.z, i2)};
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1), x2 = impl::gather_position<V>(k, i2);
     const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e), b2 = simd::load<V>(ref_[2].data() + e);
     const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e), c2 = simd::load<V>(ref_[5].data() + e);
     // Step 1. Deformation gradient and Green–Lagrange strain.
@@ -287,22 +223,18 @@ class membrane_tri {
     const V E22 = V(0.5) * (dot(F2, F2) - V(1.0));
     const V E12 = V(0.5) * dot(F1, F2);
     // Step 2. Elastic second Piola–Kirchhoff stress (Eq. 4).
-    V S11 = V(q_.Q11) * E11 + V(q_.Q12) * E22;
-    V S22 = V(q_.Q12) * E11 + V(q_.Q22) * E22;
-    V S12 = V(2.0 * q_.Q66) * E12;
+    V S11, S22, S12;
+    impl::elastic_stress(q_, E11, E22, E12, S11, S22, S12);
     // Step 3. Stiffness-proportional viscous stress β Q Ė.
     V D11(0.0), D22(0.0), D12(0.0);
     if constexpr (Damped) {
-      const vec3<V> v0{simd::gather<V>(k.vx, i0), simd::gather<V>(k.vy, i0), simd::gather<V>(k.vz, i0)};
-      const vec3<V> v1{simd::gather<V>(k.vx, i1), simd::gather<V>(k.vy, i1), simd::gather<V>(k.vz, i1)};
-      const vec3<V> v2{simd::gather<V>(k.vx, i2), simd::gather<V>(k.vy, i2), simd::gather<V>(k.vz, i2)};
+      const vec3<V> v0 = impl::gather_velocity<V>(k, i0);
+      const vec3<V> v1 = impl::gather_velocity<V>(k, i1);
+      const vec3<V> v2 = impl::gather_velocity<V>(k, i2);
       const vec3<V> G1 = v0 * b0 + v1 * b1 + v2 * b2;
       const vec3<V> G2 = v0 * c0 + v1 * c1 + v2 * c2;
       const V R11 = dot(F1, G1), R22 = dot(F2, G2), R12 = V(0.5) * (dot(F1, G2) + dot(F2, G1));
-      const V bt(beta_);
-      D11 = bt * (V(q_.Q11) * R11 + V(q_.Q12) * R22);
-      D22 = bt * (V(q_.Q12) * R11 + V(q_.Q22) * R22);
-      D12 = bt * V(2.0 * q_.Q66) * R12;
+      impl::viscous_stress(q_, V(beta_), R11, R22, R12, D11, D22, D12);
     }
     // Step 4. Wrinkling (no compression).
     mat_.wrinkling.apply(S11, S22, S12, D11, D22, D12, E11, E22, E12, q_);
@@ -314,31 +246,23 @@ class membrane_tri {
     // Pressure: (p/6) (x1 − x0) × (x2 − x0) on each corner.
     const V p6 = simd::load<V>(p_.data() + e) * V(1.0 / 6.0);
     const vec3<V> fp = cross(x1 - x0, x2 - x0) * p6;
-    store_corner<V>(f_, 0, e, fp - (P1 * b0 + P2 * c0));
-    store_corner<V>(f_, 1, e, fp - (P1 * b1 + P2 * c1));
-    store_corner<V>(f_, 2, e, fp - (P1 * b2 + P2 * c2));
+    out_.store<V>(out_.total, 0, e, fp - (P1 * b0 + P2 * c0));
+    out_.store<V>(out_.total, 1, e, fp - (P1 * b1 + P2 * c1));
+    out_.store<V>(out_.total, 2, e, fp - (P1 * b2 + P2 * c2));
     if constexpr (Track) {
       const vec3<V> Q1 = (F1 * D11 + F2 * D12) * at;
       const vec3<V> Q2 = (F1 * D12 + F2 * D22) * at;
       const vec3<V> zero{V(0.0), V(0.0), V(0.0)};
-      store_corner<V>(fd_, 0, e, zero - (Q1 * b0 + Q2 * c0));
-      store_corner<V>(fd_, 1, e, zero - (Q1 * b1 + Q2 * c1));
-      store_corner<V>(fd_, 2, e, zero - (Q1 * b2 + Q2 * c2));
-      store_corner<V>(fe_, 0, e, fp);
-      store_corner<V>(fe_, 1, e, fp);
-      store_corner<V>(fe_, 2, e, fp);
-      return V(0.5) * at * (S11 * E11 + S22 * E22 + V(2.0) * S12 * E12);
+      out_.store<V>(out_.damping, 0, e, zero - (Q1 * b0 + Q2 * c0));
+      out_.store<V>(out_.damping, 1, e, zero - (Q1 * b1 + Q2 * c1));
+      out_.store<V>(out_.damping, 2, e, zero - (Q1 * b2 + Q2 * c2));
+      out_.store<V>(out_.external, 0, e, fp);
+      out_.store<V>(out_.external, 1, e, fp);
+      out_.store<V>(out_.external, 2, e, fp);
+      return impl::membrane_energy(at, S11, S22, S12, E11, E22, E12);
     } else {
       return V(0.0);
     }
-  }
-
-  template <class V>
-  PARAFSI_INLINE void store_corner(impl::corner_buffer& b, index_t c, index_t e, const vec3<V>& f) const {
-    const std::size_t s = std::size_t(c * np_ + e);
-    simd::store(b.x.data() + s, f.x);
-    simd::store(b.y.data() + s, f.y);
-    simd::store(b.z.data() + s, f.z);
   }
 
   triangle_mesh mesh_;
@@ -352,9 +276,7 @@ class membrane_tri {
   std::array<simd::aligned_vector<double>, 6> ref_;  // b0 b1 b2 c0 c1 c2
   simd::aligned_vector<double> a0t_, p_;
   std::vector<double> lc0_;  // reference altitude 2A0/max edge
-  impl::corner_buffer f_, fd_, fe_;
-  impl::corner_scatter scatter_;
-  std::vector<double> energy_part_;
+  impl::corner_forces<3> out_;
 };
 
 }  // namespace parafsi::structure

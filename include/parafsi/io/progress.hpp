@@ -15,6 +15,7 @@
 /// interval costs one clock read. The clock is injectable for tests.
 /// io/ is never included by physics headers; this one needs the standard library only.
 #pragma once
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

@@ -1,0 +1,359 @@
+// Observers: VTK XML writers (structure .vtu, fluid .vts, .pvd) and mid-plane slices.
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <parafsi/fluid/fluid.hpp>
+#include <parafsi/io/vtk.hpp>
+#include <parafsi/structure/structure.hpp>
+
+namespace fs = std::filesystem;
+using namespace parafsi;
+namespace st = parafsi::structure;
+
+namespace {
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "parafsi_test_io_vtk";
+  fs::create_directories(d);
+  return d / name;
+}
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// ---- a minimal XML reader: elements, attributes, text; throws on malformed input.
+struct node {
+  std::string name;
+  std::map<std::string, std::string> attr;
+  std::string text;
+  std::vector<std::unique_ptr<node>> kids;
+  const node* child(const std::string& n) const {
+    for (const auto& k : kids)
+      if (k->name == n) return k.get();
+    return nullptr;
+  }
+  void find_all(const std::string& n, std::vector<const node*>& out) const {
+    if (name == n) out.push_back(this);
+    for (const auto& k : kids) k->find_all(n, out);
+  }
+  const node* array(const std::string& n) const {
+    std::vector<const node*> all;
+    find_all("DataArray", all);
+    for (auto* a : all)
+      if (a->attr.count("Name") && a->attr.at("Name") == n) return a;
+    return nullptr;
+  }
+};
+std::unique_ptr<node> parse_xml(const std::string& s) {
+  std::size_t i = 0;
+  auto fail = [&](const char* what) { throw std::runtime_error(std::string("xml: ") + what + " at " + std::to_string(i)); };
+  auto root = std::make_unique<node>();
+  root->name = "#document";
+  std::vector<node*> stack{root.get()};
+  while (i < s.size()) {
+    if (s[i] == '<') {
+      if (s.compare(i, 2, "<?") == 0) {
+        const auto e = s.find("?>", i);
+        if (e == std::string::npos) fail("unterminated declaration");
+        i = e + 2;
+        continue;
+      }
+      if (s.compare(i, 2, "</") == 0) {
+        const auto e = s.find('>', i);
+        if (e == std::string::npos) fail("unterminated end tag");
+        const std::string n = s.substr(i + 2, e - i - 2);
+        if (stack.size() < 2 || stack.back()->name != n) fail("mismatched end tag");
+        stack.pop_back();
+        i = e + 1;
+        continue;
+      }
+      auto el = std::make_unique<node>();
+      ++i;
+      while (i < s.size() && !std::isspace((unsigned char)s[i]) && s[i] != '>' && s[i] != '/') el->name += s[i++];
+      if (el->name.empty()) fail("empty tag name");
+      bool self = false;
+      for (;;) {
+        while (i < s.size() && std::isspace((unsigned char)s[i])) ++i;
+        if (i >= s.size()) fail("unterminated tag");
+        if (s[i] == '/') { self = true; if (s[i + 1] != '>') fail("bad />"); i += 2; break; }
+        if (s[i] == '>') { ++i; break; }
+        std::string k;
+        while (i < s.size() && s[i] != '=' && !std::isspace((unsigned char)s[i])) k += s[i++];
+        if (s[i] != '=' || s[i + 1] != '"') fail("attribute without quoted value");
+        const auto e = s.find('"', i + 2);
+        if (e == std::string::npos) fail("unterminated attribute");
+        if (el->attr.count(k)) fail("duplicate attribute");
+        el->attr[k] = s.substr(i + 2, e - i - 2);
+        i = e + 1;
+      }
+      node* raw = el.get();
+      stack.back()->kids.push_back(std::move(el));
+      if (!self) stack.push_back(raw);
+    } else {
+      const auto e = s.find('<', i);
+      const std::string t = s.substr(i, (e == std::string::npos ? s.size() : e) - i);
+      if (stack.size() == 1 && t.find_first_not_of(" \n\r\t") != std::string::npos) fail("text outside the root");
+      stack.back()->text += t;
+      i = e == std::string::npos ? s.size() : e;
+    }
+  }
+  if (stack.size() != 1) fail("unclosed element");
+  if (root->kids.size() != 1) fail("not exactly one root element");
+  return root;
+}
+
+std::vector<unsigned char> unbase64(const std::string& in) {
+  auto val = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    if (c == '+') return 62;
+    if (c == '/') return 63;
+    return -1;
+  };
+  std::vector<unsigned char> out;
+  unsigned buf = 0;
+  int bits = 0;
+  for (char c : in) {
+    const int v = val(c);
+    if (v < 0) continue;
+    buf = (buf << 6) | unsigned(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<unsigned char>((buf >> bits) & 0xFF));
+    }
+  }
+  return out;
+}
+
+/// Values of a DataArray as doubles (ascii or base64 binary with a UInt64 header).
+std::vector<double> values(const node* a) {
+  REQUIRE(a != nullptr);
+  std::vector<double> v;
+  const std::string type = a->attr.at("type");
+  if (a->attr.at("format") == "ascii") {
+    std::istringstream in(a->text);
+    for (double x; in >> x;) v.push_back(x);
+    return v;
+  }
+  const auto raw = unbase64(a->text);
+  REQUIRE(raw.size() >= 8);
+  std::uint64_t n;
+  std::memcpy(&n, raw.data(), 8);
+  REQUIRE(raw.size() == 8 + n);
+  const unsigned char* p = raw.data() + 8;
+  auto take = [&](auto tag) {
+    using T = decltype(tag);
+    for (std::size_t k = 0; k < n / sizeof(T); ++k) {
+      T x;
+      std::memcpy(&x, p + k * sizeof(T), sizeof(T));
+      v.push_back(double(x));
+    }
+  };
+  if (type == "Float64") take(double{});
+  else if (type == "Int64") take(std::int64_t{});
+  else if (type == "Int32") take(std::int32_t{});
+  else if (type == "UInt8") take(std::uint8_t{});
+  else FAIL("unknown type " << type);
+  return v;
+}
+
+/// membrane (2 triangles) + cable + rigid body, finalized and one step taken.
+auto small_assembly() {
+  st::nodes nd;
+  const index_t n0 = nd.add({0, 0, 1}), n1 = nd.add({1, 0, 1}), n2 = nd.add({1, 1, 1}), n3 = nd.add({0, 1, 1});
+  const index_t hang = nd.add({0.5, 0.5, 0});
+  st::triangle_mesh m;
+  m.triangles = {{n0, n1, n2}, {n0, n2, n3}};
+  m.reference = {{0, 0, 1}, {0.95, 0, 1}, {0.95, 0.95, 1}, {0, 0.95, 1}, {0.5, 0.5, 0}};  // pre-stretched
+  st::attachment body{st::rigid_body{st::rigid_body::cuboid(2.0, {0.2, 0.2, 0.2}), {0.5, 0.5, -0.1}}};
+  body.attach(hang, {0, 0, 0.1});
+  st::assembly a{std::move(nd), st::membrane_tri{m, st::material::fabric<>::isotropic(1e8, 0.3, 0.05, 1e-4)},
+                 st::cable{st::line_mesh{{{n0, hang}, {n2, hang}}, {1.1, 1.1}}, st::material::cable{1e4, 0.01, 0.05, 0}},
+                 std::move(body)};
+  a.finalize();
+  return a;
+}
+}  // namespace
+
+TEST_CASE("vtu: well-formed XML, point/cell counts, stresses and tensions round-trip (ascii and binary)") {
+  auto a = small_assembly();
+  a.step(a.stable_dt());
+  for (auto enc : {io::vtk_encoding::ascii, io::vtk_encoding::binary}) {
+    const fs::path p = scratch(enc == io::vtk_encoding::ascii ? "s_ascii.vtu" : "s_bin.vtu");
+    io::vtu_options o;
+    o.encoding = enc;
+    o.cell_tags = {7, 7, 3, 3, 9};
+    io::write_vtu(p, a, o);
+    CHECK_FALSE(fs::exists(p.string() + ".tmp"));
+    const auto doc = parse_xml(slurp(p));
+    const node* f = doc->kids[0].get();
+    CHECK(f->name == "VTKFile");
+    CHECK(f->attr.at("type") == "UnstructuredGrid");
+    const node* piece = f->child("UnstructuredGrid")->child("Piece");
+    REQUIRE(piece);
+    CHECK(piece->attr.at("NumberOfPoints") == "6");  // 5 nodes + 1 body point
+    CHECK(piece->attr.at("NumberOfCells") == "5");   // 2 triangles + 2 lines + 1 vertex
+    const auto types = values(piece->array("types"));
+    CHECK(types == std::vector<double>{5, 5, 3, 3, 1});
+    CHECK(values(piece->array("offsets")) == std::vector<double>{3, 6, 8, 10, 11});
+    CHECK(values(piece->array("connectivity")) == std::vector<double>{0, 1, 2, 0, 2, 3, 0, 4, 2, 4, 5});
+    CHECK(values(piece->array("part")) == std::vector<double>{0, 0, 1, 1, 2});
+    CHECK(values(piece->array("tag")) == std::vector<double>{7, 7, 3, 3, 9});
+    const auto pts = values(piece->child("Points")->child("DataArray"));
+    REQUIRE(pts.size() == 18);
+    for (index_t i = 0; i < 5; ++i)
+      for (int d = 0; d < 3; ++d) CHECK(pts[std::size_t(3 * i + d)] == a.node_set().position(i)[d]);
+    const auto vel = values(piece->array("velocity"));
+    for (index_t i = 0; i < 5; ++i)
+      for (int d = 0; d < 3; ++d) CHECK(vel[std::size_t(3 * i + d)] == a.node_set().velocity(i)[d]);
+    const auto S = values(piece->array("stress")), E = values(piece->array("strain"));
+    const auto vm = values(piece->array("effective_stress")), T = values(piece->array("tension"));
+    for (index_t e = 0; e < 2; ++e) {
+      const auto ss = a.part<0>().strain_stress(a.node_set(), e);
+      CHECK(ss[3] != 0.0);
+      for (int q = 0; q < 3; ++q) {
+        CHECK(E[std::size_t(3 * e + q)] == ss[std::size_t(q)]);
+        CHECK(S[std::size_t(3 * e + q)] == ss[std::size_t(3 + q)]);
+      }
+      CHECK(vm[std::size_t(e)] ==
+            doctest::Approx(std::sqrt(ss[3] * ss[3] - ss[3] * ss[4] + ss[4] * ss[4] + 3 * ss[5] * ss[5])));
+      CHECK(T[std::size_t(e)] == 0.0);
+    }
+    for (index_t e = 0; e < 2; ++e) {
+      CHECK(T[std::size_t(2 + e)] == a.part<1>().tension(a.node_set(), e));
+      CHECK(T[std::size_t(2 + e)] > 0);
+    }
+    CHECK(values(f->child("UnstructuredGrid")->child("FieldData")->child("DataArray")) ==
+          std::vector<double>{a.time()});
+  }
+  io::vtu_options bad;
+  bad.cell_tags = {1, 2};
+  CHECK_THROWS_WITH_AS(io::write_vtu(scratch("bad.vtu"), a, bad), doctest::Contains("2 cell tags for 5 cells"),
+                       invalid_input);
+}
+
+TEST_CASE("vts: inertial corner points on a turned box, cell values round-trip, vorticity of solid rotation = 2 Omega") {
+  const auto grid = fluid::rectilinear_grid(fluid::axis::refined(-1.0, 1.0, -0.3, 0.3, 0.1, 1.2),
+                                            fluid::axis::uniform(6, -0.6, 0.6), fluid::axis::uniform(5, 0.0, 1.0));
+  fluid::solver s{grid, boundary::set::all(boundary::far_field{})};
+  s.pose().X = {10.0, -2.0, 3.0};
+  s.pose().R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d Omega(0.3, -1.2, 2.0), centre(9.0, -1.0, 3.5);
+  for (index_t k = 0; k < grid.n(2); ++k)
+    for (index_t j = 0; j < grid.n(1); ++j)
+      for (index_t i = 0; i < grid.n(0); ++i) {
+        const Eigen::Vector3d x = s.pose().to_inertial({grid.centre(0, i), grid.centre(1, j), grid.centre(2, k)});
+        const Eigen::Vector3d u = Omega.cross(x - centre);
+        s.set_primitive(i, j, k, {1.0 + 0.01 * double(i + 3 * j + 7 * k), {u.x(), u.y(), u.z()}, 1e5 + double(i)});
+      }
+  const auto w = io::vorticity(s);
+  for (std::size_t c = 0; c < w.size() / 3; ++c)
+    for (int d = 0; d < 3; ++d) CHECK(w[3 * c + std::size_t(d)] == doctest::Approx(2 * Omega[d]).epsilon(1e-11));
+
+  for (auto enc : {io::vtk_encoding::ascii, io::vtk_encoding::binary}) {
+    const fs::path p = scratch(enc == io::vtk_encoding::ascii ? "f_ascii.vts" : "f_bin.vts");
+    io::write_vts(p, s, {enc});
+    const auto doc = parse_xml(slurp(p));
+    const node* sg = doc->kids[0]->child("StructuredGrid");
+    REQUIRE(sg);
+    const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
+    const std::string ext = "0 " + std::to_string(nx) + " 0 " + std::to_string(ny) + " 0 " + std::to_string(nz);
+    CHECK(sg->attr.at("WholeExtent") == ext);
+    const node* piece = sg->child("Piece");
+    const auto pts = values(piece->child("Points")->child("DataArray"));
+    REQUIRE(pts.size() == std::size_t(3 * (nx + 1) * (ny + 1) * (nz + 1)));
+    // Corner (i, j, k) = (nx, 2, 1).
+    const std::size_t q = std::size_t(nx + (nx + 1) * (2 + (ny + 1) * 1));
+    const Eigen::Vector3d xq = s.pose().to_inertial({grid.face(0, nx), grid.face(1, 2), grid.face(2, 1)});
+    for (int d = 0; d < 3; ++d) CHECK(pts[3 * q + std::size_t(d)] == xq[d]);
+    const auto rho = values(piece->array("density")), vel = values(piece->array("velocity"));
+    const auto pr = values(piece->array("pressure")), vo = values(piece->array("vorticity"));
+    REQUIRE(rho.size() == std::size_t(nx * ny * nz));
+    CHECK(vo.size() == 3 * rho.size());
+    CHECK(piece->array("eddy_viscosity") == nullptr);
+    for (index_t k = 0; k < nz; ++k)
+      for (index_t j = 0; j < ny; ++j)
+        for (index_t i = 0; i < nx; ++i) {
+          const std::size_t c = std::size_t(i + nx * (j + ny * k));
+          const auto wp = s.primitive(i, j, k);
+          CHECK(rho[c] == wp.rho);
+          CHECK(pr[c] == wp.p);
+          CHECK(vel[3 * c] == wp.u.x);
+          CHECK(vel[3 * c + 2] == wp.u.z);
+          CHECK(vo[3 * c + 1] == w[3 * c + 1]);
+        }
+  }
+
+  // Mid-plane: normal box y, through ξ_y = 0 (between layers 2 and 3).
+  const fs::path mp = scratch("mid.csv");
+  const std::size_t rows = io::write_midplane_csv(mp, s);
+  CHECK(rows == std::size_t(grid.n(0) * grid.n(2)));
+  std::ifstream in(mp);
+  std::string line;
+  std::getline(in, line);
+  CHECK(line == "x,y,z,rho,u,v,w,p,vorticity_normal");
+  std::size_t count = 0;
+  const Eigen::Vector3d ny = s.pose().R.col(1);
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));
+    REQUIRE(v.size() == 9);
+    const Eigen::Vector3d x(v[0], v[1], v[2]);
+    CHECK(s.pose().to_box(x)[1] == doctest::Approx(0.0).scale(1.0));  // on the plane
+    const Eigen::Vector3d u = Omega.cross(x - centre);
+    CHECK(v[4] == doctest::Approx(u.x()).epsilon(1e-8));  // linear field: interpolation exact
+    CHECK(v[6] == doctest::Approx(u.z()).epsilon(1e-8));
+    CHECK(v[8] == doctest::Approx(2 * Omega.dot(ny)).epsilon(1e-8));
+    ++count;
+  }
+  CHECK(count == rows);
+  CHECK_THROWS_AS(io::write_midplane_csv(mp, s, {3}), invalid_input);
+  CHECK_THROWS_AS(io::write_midplane_csv(mp, s, {1, 5.0}), invalid_input);
+}
+
+TEST_CASE("vts: eddy viscosity is written when the solver has a closure") {
+  fluid::solver s{fluid::rectilinear_grid::uniform({4, 3, 2}, {0, 0, 0}, {1, 1, 1}),
+                  boundary::set::all(boundary::far_field{}), turbulence::smagorinsky{}, viscosity::constant{}};
+  const fs::path p = scratch("t.vts");
+  io::write_vts(p, s, {io::vtk_encoding::ascii});
+  const auto doc = parse_xml(slurp(p));
+  CHECK(values(doc->kids[0]->child("StructuredGrid")->child("Piece")->array("eddy_viscosity")).size() == 24);
+}
+
+TEST_CASE("pvd: entries appended, collection always complete, resume keeps entries up to the restart time") {
+  const fs::path p = scratch("series/run.pvd");
+  {
+    io::pvd_writer w(p);
+    for (int i = 0; i < 4; ++i) w.add(0.1 * i, p.parent_path() / ("fluid_" + std::to_string(i) + ".vts"));
+    w.add(0.3, "structure_3.vtu", 1);
+    const auto doc = parse_xml(slurp(p));
+    std::vector<const node*> ds;
+    doc->find_all("DataSet", ds);
+    REQUIRE(ds.size() == 5);
+    CHECK(ds[2]->attr.at("file") == "fluid_2.vts");  // relative to the collection
+    CHECK(ds[4]->attr.at("part") == "1");
+    CHECK(std::stod(ds[1]->attr.at("timestep")) == 0.1);
+  }
+  io::pvd_writer r(p, 0.15);
+  CHECK(r.size() == 2);
+  r.add(0.2, p.parent_path() / "fluid_r.vts");
+  const auto doc = parse_xml(slurp(p));
+  std::vector<const node*> ds;
+  doc->find_all("DataSet", ds);
+  REQUIRE(ds.size() == 3);
+  CHECK(ds[2]->attr.at("file") == "fluid_r.vts");
+}

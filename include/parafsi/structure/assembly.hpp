@@ -207,6 +207,24 @@ class assembly {
     }, parts_);
   }
 
+  // ------------------------------------------------------------------ checkpoint
+  /// Length of the last substep (0 before the first): the next kick is ½(previous + Δt).
+  double previous_step() const noexcept { return dt_prev_; }
+  bool tracking_energy() const noexcept { return track_; }
+  /// Restore the clock of a checkpointed run (io/checkpoint.hpp): time, substep count,
+  /// last substep length and energy bookkeeping. Nodes, element loads and bodies are
+  /// restored through their own accessors.
+  void restore_clock(double t, long steps, double previous_step, bool track, const energy_ledger& ledger) {
+    require(std::isfinite(t) && steps >= 0 && std::isfinite(previous_step) && previous_step >= 0,
+            "assembly::restore_clock: need finite t, steps >= 0 and previous step >= 0, got t = ", t, ", steps = ",
+            steps, ", previous step = ", previous_step);
+    t_ = t;
+    steps_ = steps;
+    dt_prev_ = previous_step;
+    track_ = track;
+    ledger_ = ledger;
+  }
+
   /// Forces at the current state without advancing (phases 1–3 of a substep): the
   /// node force arrays then hold f = m g + external + element forces. For tests,
   /// diagnostics and coupling set-up. Returns the strain energy.

@@ -82,6 +82,12 @@ parafsi_coupling_example_fails(example_coupling_leak_box_bad_jump leak_box --pre
 if(TARGET bluff_body_drag)
   foreach(shape IN ITEMS disk cup)
     parafsi_coupling_example(example_coupling_bluff_${shape} bluff_body_drag "t,drag_coefficient"
-      "drag_coefficient=" --shape ${shape} --coupling embedded --cells 16 --time 0.02 --quiet)
+      "drag_coefficient=[0-9.e+-]+ " --shape ${shape} --coupling embedded --cells 4 --time 0.002 --quiet)
   endforeach()
+  parafsi_coupling_example(example_coupling_bluff_disk_penalty bluff_body_drag "t,drag_coefficient"
+    "drag_coefficient=[0-9.e+-]+ " --shape disk --coupling penalty --cells 4 --time 0.002 --quiet)
+  parafsi_coupling_example_fails(example_coupling_bluff_bad_shape bluff_body_drag --shape sphere
+    --out ${_cpl_out}/unused.csv)
+  parafsi_coupling_example_fails(example_coupling_bluff_bad_coupling bluff_body_drag --coupling foo
+    --out ${_cpl_out}/unused.csv)
 endif()

@@ -787,6 +787,15 @@ void save_checkpoint(const std::filesystem::path& path, const Parts&... parts) {
       w.f64("time", p.time());
       w.i64("steps", p.steps());
       w.i64("last_substeps", p.last_substeps());
+      w.str("coupling", p.coupling().name());
+      // Penalty coupling: the accumulated penetration of every coupling point is state
+      // the next step reads; it is written for completeness, but coupling::penalty has
+      // no setter yet, so a penalty-coupled restart is not bit-exact (docs/io.md).
+      if constexpr (requires { p.coupling().penetration(index_t(0)); p.coupling().points().size(); }) {
+        std::vector<double> d(p.coupling().points().size());
+        for (std::size_t c = 0; c < d.size(); ++c) d[c] = p.coupling().penetration(index_t(c));
+        w.f64s("penalty.penetration", d);
+      }
       w.end("stepper");
     } else if constexpr (ckpt::fluid_solver<P>) {
       ckpt::save_fluid(w, fname(nf++), p);

@@ -232,6 +232,50 @@ TEST_CASE("checkpoint: an embedded-coupling stepper restored mid-way continues b
   for (std::size_t f = 0; f < 6; ++f) CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
 }
 
+TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-identically") {
+  pf::parallel::set_threads(1);
+  auto make = [] {
+    auto grid = pf::fluid::rectilinear_grid::uniform({8, 8, 8}, {0, 0, 0}, {0.4, 0.4, 0.4});
+    pf::fluid::solver fl{grid, pf::boundary::set::all(pf::boundary::periodic{})};
+    fl.fill_uniform({1.2, {0, 0, 0}, 101325.0});
+    const auto m = pf::model::rect_mesh({0.12, 0.1, 0.11}, {0.02, 0.18, 0.0}, {0.0, 0.03, 0.17}, 3, 3);
+    st::nodes nd;
+    for (const auto& x : m.positions) nd.add(x, {4.0, 1.0, -0.5});
+    st::triangle_mesh tm;
+    tm.triangles = m.triangles;
+    st::assembly as{std::move(nd), st::membrane_tri{tm, st::material::fabric<>::isotropic(1e5, 0.3, 0.05, 1e-4)}};
+    as.integrator().gravity = {0, 0, 0};
+    pf::coupling::penalty_options o;
+    o.pfac = 1.0;
+    return pf::explicit_stepper{std::move(fl), std::move(as), pf::coupling::penalty{pf::porosity::ergun{1e9, 1e5, 1e-4}, o}};
+  };
+  auto ref = make();
+  // Varying steps, so the restored stepper must know its previous substep.
+  for (int i = 0; i < 5; ++i) ref.step((0.4 + 0.05 * i) * ref.stable_dt(0.5));
+  const fs::path p = scratch("penalty.ckpt");
+  pf::io::save_checkpoint(p, ref);
+  std::vector<double> dts;
+  for (int i = 0; i < 5; ++i) {
+    dts.push_back((0.6 - 0.04 * i) * ref.stable_dt(0.5));
+    ref.step(dts.back());
+  }
+  auto again = make();
+  pf::io::load_checkpoint(p, again);
+  CHECK(again.steps() == 5);
+  for (double dt : dts) again.step(dt);
+  CHECK(again.time() == ref.time());
+  CHECK(again.steps() == ref.steps());
+  CHECK(again.fluid().steps() == ref.fluid().steps());
+  const std::size_t L = pf::io::ckpt::soa_length(ref.fluid().grid().total_cells());
+  for (std::size_t f = 0; f < 5; ++f)
+    CHECK(same_bits(ref.fluid().conserved_storage().data(f), again.fluid().conserved_storage().data(f), L));
+  const auto& sa = ref.structure().node_set().data();
+  const auto& sb = again.structure().node_set().data();
+  for (std::size_t f = 0; f < 6; ++f) CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
+  for (std::size_t c = 0; c < ref.coupling().points().size(); ++c)
+    CHECK(ref.coupling().penetration(index_t(c)) == again.coupling().penetration(index_t(c)));
+}
+
 TEST_CASE("checkpoint: truncated, corrupted, foreign and mismatched files are refused with clear messages") {
   pf::parallel::set_threads(1);
   auto s = make_fluid();

@@ -87,6 +87,17 @@ class explicit_stepper {
   Coupling& coupling() noexcept { return coupling_; }
   /// Structure substeps of the last step.
   long last_substeps() const noexcept { return last_m_; }
+  /// Length of the last structure substep (0 before the first step): the next step's
+  /// first coupling kick uses it, so a checkpoint stores it.
+  double previous_substep() const noexcept { return prev_substep_; }
+  /// Restore the stepper's clock after its parts were restored from a checkpoint.
+  void restore_clock(double t, long steps, double previous_substep, long last_substeps) {
+    require(std::isfinite(t) && steps >= 0, "explicit_stepper::restore_clock: bad time/steps");
+    t_ = t;
+    steps_ = steps;
+    prev_substep_ = previous_substep;
+    last_m_ = last_substeps;
+  }
   const stepper_phase_times& timings() const noexcept { return times_; }
   void reset_timings() noexcept { times_ = {}; }
   /// Upper bound on substeps per fluid step; more is an error naming the cause.

@@ -126,6 +126,12 @@ class penalty {
   const penalty_diagnostics& diagnostics() const noexcept { return diag_; }
   /// Signed penetration of point c (m).
   double penetration(index_t c) const { return d_[std::size_t(c)]; }
+  /// Set the penetration of point c (restart from a checkpoint).
+  void set_penetration(index_t c, double d) {
+    require(c >= 0 && std::size_t(c) < d_.size() && std::isfinite(d), "coupling::penalty::set_penetration: bad point ",
+            c, " or value ", d);
+    d_[std::size_t(c)] = d;
+  }
   /// Total through-flow Σ_e (m³/s) and coupled area (m²) at the last substep.
   double total_through_flow() const {
     double q = 0;

@@ -241,6 +241,8 @@ class solver {
   const rectilinear_grid& grid() const noexcept { return grid_; }
   double time() const noexcept { return t_; }
   long steps() const noexcept { return steps_; }
+  /// Restore the step count (restart from a checkpoint).
+  void set_steps(long n) { steps_ = n; }
   /// Use OpenMP threads in the step phases (default: on for grids of ≥ 32768 cells).
   void set_threading(bool on) noexcept { threaded_ = on; }
   bool threading() const noexcept { return threaded_; }

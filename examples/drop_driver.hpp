@@ -39,22 +39,24 @@ using pf::index_t;
 struct resolution {
   double element = 0.05;  ///< canopy element size / D0
   double cell = 0.10;     ///< fluid cell size around the canopy / D0
+  double growth = 1.3;    ///< cell growth factor outside the refined block
 };
 
-/// coarse: element D0/20, cell D0/10; medium: D0/40, D0/20; fine: D0/60, D0/30;
-/// tiny (tests): D0/10, D0/5.
+/// coarse: element D0/20, cell D0/10, growth 1.3 (17 576 cells); medium: D0/40, D0/20,
+/// growth 1.12 (about the paper's finest validation mesh, ≈ 1.6e5 cells); fine: D0/60,
+/// D0/30, growth 1.1; tiny (tests): D0/10, D0/5, growth 1.3.
 inline resolution preset(const std::string& name) {
-  if (name == "medium") return {0.025, 0.05};
-  if (name == "fine") return {0.0167, 0.0333};
-  if (name == "tiny") return {0.1, 0.2};
-  return {0.05, 0.10};
+  if (name == "medium") return {0.025, 0.05, 1.12};
+  if (name == "fine") return {0.0167, 0.0333, 1.1};
+  if (name == "tiny") return {0.1, 0.2, 1.3};
+  return {0.05, 0.10, 1.3};
 }
 
 struct drop_config {
   std::string canopy = "paper", fabric = "mat544", resolution = "coarse", coupling = "penalty";
   std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at coarse/tiny)
   double t_end = 6.0, history_every = 0.005;
-  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 1.3, cfl = 0.9;
+  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;  // growth 0: preset
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
@@ -78,6 +80,7 @@ inline drop_result run_drop(const drop_config& c) {
     const double D0 = P.canopy.nominal_diameter;
     resolution R = preset(c.resolution);
     if (c.cell > 0) R.cell = c.cell;
+    if (c.growth > 0) R.growth = c.growth;
     if (c.element > 0) R.element = c.element;
     if (c.initial_speed >= 0) P.initial_speed = c.initial_speed;
     P.canopy.element_size = R.element * D0;
@@ -122,8 +125,8 @@ inline drop_result run_drop(const drop_config& c) {
     // meet the skirt about 0.94 Ls above the confluence) to above the inflated crown.
     const double rz0 = (zc + 0.55 * P.line_length_ratio) * D0, rz1 = (zc + 1.0 * P.line_length_ratio + 0.55) * D0;
     const double h = R.cell * D0;
-    const auto ax = pf::fluid::axis::refined(-half, half, -0.6 * D0, 0.6 * D0, h, c.growth);
-    const auto az = pf::fluid::axis::refined(zlo, zhi, std::max(zlo, rz0), std::min(zhi, rz1), h, c.growth);
+    const auto ax = pf::fluid::axis::refined(-half, half, -0.6 * D0, 0.6 * D0, h, R.growth);
+    const auto az = pf::fluid::axis::refined(zlo, zhi, std::max(zlo, rz0), std::min(zhi, rz1), h, R.growth);
     pf::fluid::rectilinear_grid grid{ax, ax, az};
     const pf::fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, P.air_pressure};
     auto bc = pf::boundary::set::all(pf::boundary::far_field{air.rho, air.u, air.p});
@@ -284,6 +287,11 @@ inline drop_result run_drop(const drop_config& c) {
       long substeps = 0;
       while (s.time() < c.t_end - 1e-12) {
         double dt = s.stable_dt(c.cfl);
+        if (!(dt > 1e-9 * c.history_every) || !std::isfinite(dt))
+          throw pf::numerical_failure(pf::detail::concat("parachute_drop: the stable step collapsed to ", dt,
+                                                         " s at t = ", s.time(), " s (coupling ", c.coupling,
+                                                         "); stopping"),
+                                      -1, s.time());
         const double target = std::min(next_out, c.t_end);
         const double left = target - s.time();
         if (dt >= left * (1.0 - 1e-9)) dt = left;

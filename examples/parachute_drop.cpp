@@ -12,7 +12,7 @@
 // frame::follow_payload translates it with the payload mass centre and turns its −z axis
 // to the payload velocity, tracked every step. Far field + sponge on all six faces; cells
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
-// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity; penalty
+// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at coarse); penalty
 // coupling with the fabric's Ergun law (docs/coupling.md).
 //
 // Writes in DIR: history.csv (one row per --history-every ≤ 5 ms), summary.csv, and
@@ -20,6 +20,8 @@
 // include/parafsi/io/drop_summary.hpp and docs/validation.md. Progress on stderr; the
 // summary row on stdout at the end.
 #include "drop_driver.hpp"
+
+#include <cstdlib>
 
 namespace {
 
@@ -39,7 +41,7 @@ int main(int argc, char** argv) {
   std::string canopy = "paper", fabric = "mat544", res_name = "coarse", coupling = "penalty", out = "out/drop";
   std::string restart, slice_times = "0.1,0.2,0.3,0.5,1,2,4,6";
   double t_end = 6.0, vtk_every = 0, checkpoint_every = 0, history_every = 0.005;
-  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 1.3, cfl = 0.9;
+  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
   int threads = 0;
@@ -76,9 +78,8 @@ int main(int argc, char** argv) {
   app.add_option("--box-ahead", box_ahead, "box length ahead of the payload / D0")
       ->check(CLI::Range(0.3, 50.0))
       ->capture_default_str();
-  app.add_option("--growth", growth, "cell growth factor outside the refined region")
-      ->check(CLI::Range(1.0, 2.0))
-      ->capture_default_str();
+  app.add_option("--growth", growth, "cell growth factor outside the refined region (default: the resolution's)")
+      ->check(CLI::Range(1.0, 2.0));
   app.add_option("--cell", h_cell, "override: fluid cell size around the canopy / D0")->check(CLI::Range(0.0, 1.0));
   app.add_option("--element", h_element, "override: canopy element size / D0")->check(CLI::Range(0.0, 1.0));
   app.add_option("--cfl", cfl, "CFL number of the fluid step")->check(CLI::Range(0.01, 1.0))->capture_default_str();
@@ -105,6 +106,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "parachute_drop: error: --vtk-every, --checkpoint-every and --restart are not available yet "
                  "(the io/vtk, io/checkpoint headers are not in this version)\n");
+    return 2;
+  }
+  if (coupling == "embedded" && !std::getenv("PARAFSI_DROP_EMBEDDED")) {
+    // Measured: on the tiny drop grid the embedded coupling's stable step collapses
+    // (t stalls at 0.0171 s, > 88 000 steps); see docs/validation.md. The path stays
+    // compiled; PARAFSI_DROP_EMBEDDED=1 runs it (and the stall guard stops it).
+    std::fprintf(stderr,
+                 "parachute_drop: error: --coupling embedded is not available for the drop yet (its stable step "
+                 "collapses at t = 0.017 s; see docs/validation.md); use --coupling penalty\n");
     return 2;
   }
   if (threads > 0) parafsi::parallel::set_threads(threads);

@@ -1,0 +1,50 @@
+// A short drop regression: the full coupled drop (examples/drop_driver.hpp, the code
+// path of parachute_drop) on the tiny grid (canopy elements D0/10, fluid cells D0/5
+// around the canopy), released at 8 m/s so the canopy is loaded within the 0.25 s
+// simulated. Stored values (recorded with this code) with tolerances wide enough for
+// compiler and instruction-set differences, narrow enough to catch a changed scene,
+// coupling or stepper; plus physical bounds that hold whatever the numbers.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "../examples/drop_driver.hpp"
+
+using doctest::Approx;
+
+TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
+  parafsi::parallel::set_threads(1);
+  examples::drop::drop_config c;
+  c.resolution = "tiny";
+  c.t_end = 0.25;
+  c.initial_speed = 8.0;
+  c.quiet = true;
+  const auto r = examples::drop::run_drop(c);
+  REQUIRE(!r.history.empty());
+  const auto& e = r.history.back();
+  std::printf("drop regression: cells %ld, steps %ld, wall %.2f s\n", r.cells, r.steps, r.wall);
+  std::printf("  t=%.4f z=%.6f speed=%.6f D=%.6f F=%.6f phi=(%.4g, %.4g) F_p=%.6f t_p=%.4f D_max=%.6f\n", e.t, e.z,
+              e.speed, e.canopy_diameter, e.open_force, e.canopy_phi_x, e.canopy_phi_y, r.summary.F_p,
+              r.summary.t_p, r.summary.max_diameter);
+  CHECK(e.t == Approx(0.25).epsilon(1e-12));
+  CHECK(r.history.size() == 51);  // one row per 5 ms and the start
+  // Physical bounds: released at 8 m/s downwards, the payload falls at most as in vacuum
+  // and the air slows it; the canopy opens from its packed 0.2 D0.
+  const double z_free = 35.0 - 8.0 * 0.25 - 0.5 * 9.81 * 0.25 * 0.25;
+  CHECK(e.z > z_free);
+  CHECK(e.speed < 8.0 + 9.81 * 0.25);
+  CHECK(e.canopy_diameter > 0.2);
+  CHECK(r.summary.F_p > 0.0);
+  // Symmetric scene, vertical drop: the attitude stays small.
+  CHECK(std::fabs(e.canopy_phi_x) < 5.0);
+  CHECK(std::fabs(e.canopy_phi_y) < 5.0);
+  // Stored values (recorded 2026-11 with the coarse defaults: CFL 0.9, growth 1.3,
+  // inviscid, PFAC 1, lambda 0.25; 4352 cells, 1500 steps, ~2.7 s wall).
+  CHECK(e.z == Approx(33.071028).epsilon(2e-4));
+  CHECK(e.speed == Approx(7.237261).epsilon(0.02));
+  CHECK(e.canopy_diameter == Approx(0.410301).epsilon(0.03));
+  CHECK(r.summary.F_p == Approx(49.425515).epsilon(0.05));
+  CHECK(r.summary.max_diameter == Approx(0.410301).epsilon(0.03));
+  CHECK(r.wall < 60.0);
+}

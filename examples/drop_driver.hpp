@@ -21,10 +21,14 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
+#include <parafsi/io/checkpoint.hpp>
 #include <parafsi/io/drop_summary.hpp>
+#include <parafsi/io/vtk.hpp>
 #include <parafsi/model/drop_scene.hpp>
 
+#include <cmath>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <sstream>
 
@@ -62,6 +66,9 @@ struct drop_config {
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
   std::vector<double> slice_times;
   std::string out;                ///< output directory; empty: no files
+  double vtk_every = 0;           ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
+  double checkpoint_every = 0;    ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
+  std::string restart;            ///< checkpoint to continue from (same scene and flags)
   bool quiet = false;
 };
 
@@ -250,13 +257,56 @@ inline drop_result run_drop(const drop_config& c) {
         }
       };
 
+      drop_result res;
+      // Restart: the stepper's full state from the checkpoint; the history rows up to the
+      // restored time from <out>/history.csv.
+      std::vector<io::drop_history_row> previous;
+      if (!c.restart.empty()) {
+        io::load_checkpoint(c.restart, s);
+        std::ifstream in(c.out + "/history.csv");
+        std::string line;
+        std::getline(in, line);
+        while (std::getline(in, line)) {
+          std::array<double, io::drop_history_row::columns> v{};
+          std::stringstream ls(line);
+          std::string item;
+          std::size_t k = 0;
+          while (k < v.size() && std::getline(ls, item, ',')) v[k++] = item == "nan" ? NAN : std::stod(item);
+          if (k == v.size() && v[0] <= s.time() + 1e-12) previous.push_back(io::drop_history_row::from(v));
+        }
+        if (!c.quiet) std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows kept)\n",
+                                   c.restart.c_str(), s.time(), previous.size());
+      }
       std::ofstream hist;
       if (files) {
         hist.open(c.out + "/history.csv");
         if (!hist) throw pf::invalid_input("parachute_drop: cannot write '" + c.out + "/history.csv'");
         hist << io::drop_history_header << '\n';
+        for (const auto& r : previous) io::write_history_row(hist, r);
       }
-      drop_result res;
+      res.history = previous;
+      std::optional<io::pvd_writer> pvd;
+      if (files && c.vtk_every > 0) {
+        std::filesystem::create_directories(c.out + "/vtk");
+        pvd.emplace(c.out + "/drop.pvd", c.restart.empty() ? NAN : s.time());
+      }
+      double next_vtk = s.time(), next_ckpt = s.time() + c.checkpoint_every;
+      auto observers = [&] {
+        if (pvd && s.time() >= next_vtk - 1e-9 * c.history_every) {
+          char nm[64];
+          std::snprintf(nm, sizeof nm, "%09.5f", s.time());
+          const std::string fs = c.out + "/vtk/structure_" + nm + ".vtu", ff = c.out + "/vtk/fluid_" + nm + ".vts";
+          io::write_vtu(fs, s.structure());
+          io::write_vts(ff, s.fluid());
+          pvd->add(s.time(), ff, 0);
+          pvd->add(s.time(), fs, 1);
+          next_vtk += c.vtk_every;
+        }
+        if (files && c.checkpoint_every > 0 && s.time() >= next_ckpt - 1e-9 * c.history_every) {
+          io::save_checkpoint(c.out + "/checkpoint.ckpt", s);
+          next_ckpt += c.checkpoint_every;
+        }
+      };
       res.cells = ncells;
       res.nodes = long(nd.size());
       res.triangles = long(S.triangles.size());
@@ -276,10 +326,12 @@ inline drop_result run_drop(const drop_config& c) {
                      P.name.c_str(), fabric_name.c_str(), c.resolution.c_str(), ncells, long(grid.n(0)),
                      long(grid.n(1)), long(grid.n(2)), h, long(nd.size()), S.triangles.size(), c.coupling.c_str(),
                      c.t_end);
-      record();
+      if (c.restart.empty()) record();
+      observers();
       examples::progress prog("parachute_drop", c.t_end, c.quiet);
-      double next_out = c.history_every;
+      double next_out = c.history_every * (std::floor(s.time() / c.history_every + 1e-6) + 1.0);
       std::size_t next_slice = 0;
+      while (next_slice < slices.size() && slices[next_slice] <= s.time() + 1e-9 && !c.restart.empty()) ++next_slice;
       while (files && next_slice < slices.size() && slices[next_slice] <= 0) {
         write_slice(0.0);
         ++next_slice;
@@ -304,6 +356,7 @@ inline drop_result run_drop(const drop_config& c) {
         substeps += s.last_substeps();
         if (s.time() >= next_out - 1e-9 * c.history_every || s.time() >= c.t_end - 1e-12) {
           record();
+          observers();
           next_out += c.history_every;
           while (files && next_slice < slices.size() && s.time() >= slices[next_slice] - 1e-9) {
             write_slice(slices[next_slice]);

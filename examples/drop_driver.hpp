@@ -25,6 +25,7 @@
 #include <parafsi/io/drop_summary.hpp>
 #include <parafsi/io/vtk.hpp>
 #include <parafsi/model/drop_scene.hpp>
+#include <parafsi/structure/from_drop_scene.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -95,33 +96,7 @@ inline drop_result run_drop(const drop_config& c) {
     const std::string fabric_name(S.fabric.name);
 
     // ------------------------------------------------------------ structure
-    st::nodes nodes;
-    for (std::size_t i = 0; i < S.positions.size(); ++i) nodes.add(S.positions[i], S.velocities[i], S.point_mass[i]);
-    st::triangle_mesh tm;
-    tm.triangles = S.triangles;
-    tm.reference = S.reference;
-    tm.warp_per_element = S.warp;
-    const auto& m = S.moduli;
-    st::membrane_tri membrane{tm, st::material::fabric<>{m.E11, m.E22, m.nu12, m.G12, m.areal_density, m.thickness},
-                              st::membrane_options{c.membrane_damping}};
-    auto part = [&](md::cable_kind k) {
-      const auto& cs = S.cable(k);
-      return st::cable{st::line_mesh{cs.segments, cs.rest_length},
-                       st::material::cable{cs.material.EA(), cs.material.mass_per_length, cs.material.damping_ratio, 0.0}};
-    };
-    st::attachment payload{st::rigid_body{st::rigid_body::cuboid(S.payload.mass, S.payload.size), S.payload.position,
-                                          S.payload.attitude, S.payload.velocity}};
-    for (const auto& a : S.attachments) payload.attach(a.node, a.r_body);
-    st::assembly chute{std::move(nodes),
-                       std::move(membrane),
-                       part(md::cable_kind::suspension_line),
-                       part(md::cable_kind::riser),
-                       part(md::cable_kind::skirt_tape),
-                       part(md::cable_kind::vent_tape),
-                       part(md::cable_kind::radial_band),
-                       std::move(payload)};
-    chute.integrator().gravity = {0, 0, -P.gravity};
-    chute.finalize();
+    auto chute = st::make_drop_assembly(S, c.membrane_damping);
 
     // ------------------------------------------------------------ fluid box
     // Box coordinates: payload mass centre at ξ = 0, box +z against the flight direction

@@ -205,38 +205,13 @@ TEST_CASE("scene: bad parameters are rejected with the value named") {
                        doctest::Contains("got -0.1"), pf::invalid_input);
 }
 
-#include <parafsi/structure/structure.hpp>
+#include <parafsi/structure/from_drop_scene.hpp>
 
 TEST_CASE("scene data plugs into the structure module as is; lumped masses match") {
   namespace st = parafsi::structure;
   const auto s = md::build_drop_scene(md::drop_scene_parameters::paper());
-  st::nodes nodes;
-  for (std::size_t i = 0; i < s.positions.size(); ++i) nodes.add(s.positions[i], s.velocities[i], s.point_mass[i]);
-  st::triangle_mesh tm;
-  tm.triangles = s.triangles;
-  tm.reference = s.reference;
-  tm.warp_per_element = s.warp;
-  const auto& m = s.moduli;
-  st::membrane_tri membrane{tm, st::material::fabric<>{m.E11, m.E22, m.nu12, m.G12, m.areal_density, m.thickness},
-                            st::membrane_options{0.05}};
-  auto part = [&](md::cable_kind k) {
-    const auto& c = s.cable(k);
-    return st::cable{st::line_mesh{c.segments, c.rest_length},
-                     st::material::cable{c.material.EA(), c.material.mass_per_length, c.material.damping_ratio, 0.0}};
-  };
-  st::attachment payload{st::rigid_body{st::rigid_body::cuboid(s.payload.mass, s.payload.size), s.payload.position,
-                                        s.payload.attitude, s.payload.velocity}};
-  for (const auto& a : s.attachments) payload.attach(a.node, a.r_body);
-  st::assembly chute{std::move(nodes),
-                     std::move(membrane),
-                     part(md::cable_kind::suspension_line),
-                     part(md::cable_kind::riser),
-                     part(md::cable_kind::skirt_tape),
-                     part(md::cable_kind::vent_tape),
-                     part(md::cable_kind::radial_band),
-                     std::move(payload)};
-  chute.integrator().gravity = {0, 0, -s.params.gravity};
-  chute.finalize();
+  // The membrane damping is irrelevant here (50 steps of free fall).
+  auto chute = st::make_drop_assembly(s, 0.05);
   for (index_t i = 0; i < s.node_count(); ++i)
     CHECK(chute.node_set().mass(i) == doctest::Approx(s.lumped_mass[std::size_t(i)]).epsilon(1e-12));
   // The body received the hanging node's lumped mass.

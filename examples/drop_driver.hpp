@@ -304,7 +304,10 @@ inline drop_result run_drop(const drop_config& c) {
       if (c.restart.empty()) record();
       observers();
       examples::progress prog("parachute_drop", c.t_end, c.quiet);
-      double next_out = c.history_every * (std::floor(s.time() / c.history_every + 1e-6) + 1.0);
+      // Output times are n·history_every with an integer n (not a running sum), so a run
+      // restarted from a checkpoint picks exactly the steps of the uninterrupted run.
+      long n_out = long(std::floor(s.time() / c.history_every + 1e-6)) + 1;
+      double next_out = c.history_every * double(n_out);
       std::size_t next_slice = 0;
       while (next_slice < slices.size() && slices[next_slice] <= s.time() + 1e-9 && !c.restart.empty()) ++next_slice;
       while (files && next_slice < slices.size() && slices[next_slice] <= 0) {
@@ -332,7 +335,7 @@ inline drop_result run_drop(const drop_config& c) {
         if (s.time() >= next_out - 1e-9 * c.history_every || s.time() >= c.t_end - 1e-12) {
           record();
           observers();
-          next_out += c.history_every;
+          next_out = c.history_every * double(++n_out);
           while (files && next_slice < slices.size() && s.time() >= slices[next_slice] - 1e-9) {
             write_slice(slices[next_slice]);
             ++next_slice;

@@ -37,6 +37,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -217,14 +218,19 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   return s;
 }
 
-/// One history row as CSV text (full precision, NaN written as `nan`).
+/// One history row as CSV text: the shortest text that reads back to the same double
+/// (so a restart that re-reads the history keeps it bit-exact), NaN written as `nan`.
 inline void write_history_row(std::ostream& os, const drop_history_row& r) {
   const auto v = r.values();
   char buf[40];
   for (std::size_t i = 0; i < v.size(); ++i) {
-    if (std::isfinite(v[i])) std::snprintf(buf, sizeof buf, "%.10g", v[i]);
-    else std::snprintf(buf, sizeof buf, "nan");
-    os << (i ? "," : "") << buf;
+    os << (i ? "," : "");
+    if (std::isfinite(v[i])) {
+      const auto res = std::to_chars(buf, buf + sizeof buf, v[i]);
+      os.write(buf, res.ptr - buf);
+    } else {
+      os << "nan";
+    }
   }
   os << '\n';
 }

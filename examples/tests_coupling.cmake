@@ -55,9 +55,12 @@ function(parafsi_coupling_example_fails name program)
   set_tests_properties(${name} PROPERTIES WILL_FAIL TRUE TIMEOUT 60 LABELS "examples;coupling")
 endfunction()
 
-# ---- piston (penalty): short run on the default duct.
+# ---- piston, both couplings: short run on the default duct.
 if(TARGET piston)
   parafsi_coupling_example(example_coupling_piston piston "" "pressure_rise=.*rho_c_v=" --time 0.002)
+  parafsi_coupling_example(example_coupling_piston_embedded piston "" "pressure_rise=.*rho_c_v=" --time 0.002
+                           --coupling embedded)
+  parafsi_coupling_example_fails(example_coupling_piston_bad_coupling piston --coupling glue)
   parafsi_coupling_example_fails(example_coupling_piston_bad_velocity piston --velocity -1)
 endif()
 

@@ -29,6 +29,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 #include <fstream>
 #include <sstream>
@@ -65,6 +66,13 @@ struct drop_config {
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
+  double payload_mass = -1;       ///< override of the payload mass (kg), < 0 = scene
+  double line_stiffness = 1;      ///< multiplies EA of lines, riser and tapes (sensitivity, extremes)
+  double modulus_scale = 1;       ///< multiplies the fabric moduli E11, E22, G12
+  std::string packed = "scene";   ///< scene | reduced_radius | star_fold | constructed
+  double packed_parameter = -1;   ///< reduced_radius: s; star_fold: seam half-angle (deg); < 0 = default
+  std::string box = "follow";     ///< follow: the paper's moving box; fixed: a fixed box holding the fall
+  double fixed_fall = 0;          ///< fixed box: fall length (m) the refined column extends below the start
   std::vector<double> slice_times;
   std::string out;                ///< output directory; empty: no files
   double vtk_every = 0;           ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
@@ -91,6 +99,22 @@ inline drop_result run_drop(const drop_config& c) {
     if (c.growth > 0) R.growth = c.growth;
     if (c.element > 0) R.element = c.element;
     if (c.initial_speed >= 0) P.initial_speed = c.initial_speed;
+    if (c.payload_mass > 0) P.payload.mass = c.payload_mass;
+    pf::require(c.line_stiffness > 0 && std::isfinite(c.line_stiffness),
+                "parachute_drop: line stiffness scale must be > 0, got ", c.line_stiffness);
+    for (auto* l : {&P.line, &P.skirt_tape, &P.vent_tape, &P.band}) l->stiffness_scale *= c.line_stiffness;
+    pf::require(c.modulus_scale > 0 && std::isfinite(c.modulus_scale),
+                "parachute_drop: fabric modulus scale must be > 0, got ", c.modulus_scale);
+    P.moduli.modulus_scale *= c.modulus_scale;
+    if (c.packed == "reduced_radius") P.shape = md::packed_shape::reduced_radius(c.packed_parameter > 0 ? c.packed_parameter : 0.2);
+    else if (c.packed == "star_fold")
+      P.shape = md::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi / 180.0);
+    else if (c.packed == "constructed") P.shape = md::packed_shape::constructed();
+    else pf::require(c.packed == "scene", "parachute_drop: unknown packed shape '", c.packed, "'");
+    pf::require(c.box == "follow" || c.box == "fixed", "parachute_drop: box must be follow or fixed, got '", c.box, "'");
+    const bool fixed_box = c.box == "fixed";
+    pf::require(!fixed_box || (c.fixed_fall > 0 && std::isfinite(c.fixed_fall)),
+                "parachute_drop: a fixed box needs the fall length it must hold (> 0 m), got ", c.fixed_fall);
     P.canopy.element_size = R.element * D0;
     const md::drop_scene S = md::build_drop_scene(P);
     const std::string fabric_name(S.fabric.name);
@@ -102,10 +126,13 @@ inline drop_result run_drop(const drop_config& c) {
     // Box coordinates: payload mass centre at ξ = 0, box +z against the flight direction
     // (towards the canopy), so box −z follows the payload velocity.
     const double zc = (S.positions[std::size_t(S.suspension.confluence)] - S.payload.position).dot(S.axis()) / D0;
-    const double zlo = -c.box_ahead * D0, zhi = (c.box_length - c.box_ahead) * D0, half = 0.5 * c.box_width * D0;
+    // A fixed box (box = fixed) is the following box at the start, lengthened downwards
+    // by the fall it must hold, with the refined column lengthened by the same amount.
+    const double fall = fixed_box ? c.fixed_fall : 0.0;
+    const double zlo = -c.box_ahead * D0 - fall, zhi = (c.box_length - c.box_ahead) * D0, half = 0.5 * c.box_width * D0;
     // Refined region: the canopy (radius ≤ 0.6 D0) from just below the skirt (the lines
     // meet the skirt about 0.94 Ls above the confluence) to above the inflated crown.
-    const double rz0 = (zc + 0.55 * P.line_length_ratio) * D0, rz1 = (zc + 1.0 * P.line_length_ratio + 0.55) * D0;
+    const double rz0 = (zc + 0.55 * P.line_length_ratio) * D0 - fall, rz1 = (zc + 1.0 * P.line_length_ratio + 0.55) * D0;
     const double h = R.cell * D0;
     const auto ax = pf::fluid::axis::refined(-half, half, -0.6 * D0, 0.6 * D0, h, R.growth);
     const auto az = pf::fluid::axis::refined(zlo, zhi, std::max(zlo, rz0), std::min(zhi, rz1), h, R.growth);
@@ -118,14 +145,18 @@ inline drop_result run_drop(const drop_config& c) {
     follow.max_rate = 10.0;
     pf::viscosity::constant visc;
     visc.mu_value = P.air_viscosity;
-    auto make_fluid = [&](auto viscosity) {
+    auto make_fluid = [&](auto viscosity, auto frame) {
       return pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{}, viscosity,
-                               follow};
+                               frame};
+    };
+    auto with_frame = [&](auto viscosity, auto&& go) -> drop_result {
+      if (fixed_box) return go(make_fluid(viscosity, pf::frame::fixed{}));
+      return go(make_fluid(viscosity, follow));
     };
     auto with_fluid = [&](auto&& go) -> drop_result {
       if (c.viscosity == "inviscid" || (c.viscosity == "auto" && (c.resolution == "coarse" || c.resolution == "tiny")))
-        return go(make_fluid(pf::viscosity::inviscid{}));
-      return go(make_fluid(visc));
+        return with_frame(pf::viscosity::inviscid{}, go);
+      return with_frame(visc, go);
     };
     return with_fluid([&](auto fl) -> drop_result {
     fl.initialize([&](const Eigen::Vector3d&) { return air; });
@@ -141,7 +172,7 @@ inline drop_result run_drop(const drop_config& c) {
       fl.pose().R.col(2) = zb;
     }
     fl.pose().X = chute.part<6>().body().mass_centre();
-    fl.pose().V = chute.part<6>().body().mass_centre_velocity();
+    if (!fixed_box) fl.pose().V = chute.part<6>().body().mass_centre_velocity();
     if (pf::parallel::max_threads() > 1) fl.set_threading(true);
     const long ncells = long(grid.n(0)) * grid.n(1) * grid.n(2);
 
@@ -297,10 +328,10 @@ inline drop_result run_drop(const drop_config& c) {
       if (!c.quiet)
         std::fprintf(stderr,
                      "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%ldx%ldx%ld, h = %.4g m near the canopy), "
-                     "%ld structure nodes, %zu triangles, coupling %s, t_end %.3g s\n",
+                     "%ld structure nodes, %zu triangles, coupling %s, %s box, t_end %.3g s\n",
                      P.name.c_str(), fabric_name.c_str(), c.resolution.c_str(), ncells, long(grid.n(0)),
                      long(grid.n(1)), long(grid.n(2)), h, long(nd.size()), S.triangles.size(), c.coupling.c_str(),
-                     c.t_end);
+                     c.box.c_str(), c.t_end);
       if (c.restart.empty()) record();
       observers();
       examples::progress prog("parachute_drop", c.t_end, c.quiet);
@@ -329,7 +360,17 @@ inline drop_result run_drop(const drop_config& c) {
         const auto& body = as.template part<6>().body();
         const Eigen::Vector3d xp = body.mass_centre(), vp = body.mass_centre_velocity();
         const Eigen::Vector3d g{0, 0, -P.gravity};
-        s.fluid().frame().track(xp + vp * dt, vp + g * dt);
+        if constexpr (requires { s.fluid().frame().track(xp, vp); }) {
+          s.fluid().frame().track(xp + vp * dt, vp + g * dt);
+        } else {
+          // Fixed box: stop with a message before the payload leaves the refined column.
+          const Eigen::Vector3d xi = s.fluid().pose().R.transpose() * (xp - s.fluid().pose().X);
+          if (xi.z() < -fall)
+            throw pf::numerical_failure(pf::detail::concat("parachute_drop: the payload has fallen ", -xi.z(),
+                                                           " m, beyond the fixed box's fall length ", fall,
+                                                           " m, at t = ", s.time(), " s; raise --fixed-fall"),
+                                        -1, s.time());
+        }
         s.step(dt);
         substeps += s.last_substeps();
         if (s.time() >= next_out - 1e-9 * c.history_every || s.time() >= c.t_end - 1e-12) {

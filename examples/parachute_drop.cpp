@@ -14,6 +14,9 @@
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
 // --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at coarse); penalty
 // coupling with the fabric's Ergun law (docs/coupling.md).
+// Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
+// following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
+// --payload-mass, --initial-speed (extreme scenes).
 //
 // Writes in DIR: history.csv (one row per --history-every ≤ 5 ms), summary.csv, and
 // mid-plane slices slice_<t>.csv (+ slice_<t>_nodes.csv) at --slice-times. Definitions:
@@ -44,6 +47,8 @@ int main(int argc, char** argv) {
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
+  double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
+  std::string packed = "scene", box = "follow";
   int threads = 0;
   bool quiet = false;
   std::string viscosity = "auto";
@@ -100,6 +105,25 @@ int main(int argc, char** argv) {
                  "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
+  app.add_option("--payload-mass", payload_mass, "override: payload mass (kg); default: the scene's")
+      ->check(CLI::Range(1e-3, 1e5));
+  app.add_option("--line-stiffness", line_stiffness, "multiplies EA of the lines, riser and tapes")
+      ->check(CLI::Range(1e-3, 1e4))
+      ->capture_default_str();
+  app.add_option("--modulus-scale", modulus_scale, "multiplies the fabric moduli E11, E22, G12")
+      ->check(CLI::Range(1e-3, 1e3))
+      ->capture_default_str();
+  app.add_option("--packed", packed, "initial packed canopy shape (scene: the scene's, reduced radius 0.2 for paper)")
+      ->check(CLI::IsMember({"scene", "reduced_radius", "star_fold", "constructed"}))
+      ->capture_default_str();
+  app.add_option("--packed-parameter", packed_parameter,
+                 "reduced_radius: radial scale s (default 0.2); star_fold: seam half-angle in degrees (default 5)")
+      ->check(CLI::Range(0.0, 89.0));
+  app.add_option("--box", box, "fluid box: follow (the paper's, moves and turns with the payload) or fixed")
+      ->check(CLI::IsMember({"follow", "fixed"}))
+      ->capture_default_str();
+  app.add_option("--fixed-fall", fixed_fall, "fixed box: fall length (m) it must hold below the release point")
+      ->check(CLI::Range(0.0, 1000.0));
   int rc = 0;
   if (!examples::parse(app, argc, argv, rc)) return rc;
   if (coupling == "embedded" && !std::getenv("PARAFSI_DROP_EMBEDDED")) {
@@ -139,6 +163,13 @@ int main(int argc, char** argv) {
     c.cell = h_cell;
     c.element = h_element;
     c.initial_speed = initial_speed;
+    c.payload_mass = payload_mass;
+    c.line_stiffness = line_stiffness;
+    c.modulus_scale = modulus_scale;
+    c.packed = packed;
+    c.packed_parameter = packed_parameter;
+    c.box = box;
+    c.fixed_fall = fixed_fall;
     c.slice_times = parse_list(slice_times);
     c.out = out;
     c.vtk_every = vtk_every;

@@ -94,3 +94,43 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   CHECK(cont.steps == full.steps);  // the step count is part of the restored state
   fs::remove_all(base);
 }
+
+// Extreme scenes on the tiny grid (0.25 s): ten times the payload, a release at 30 m/s
+// and lines a hundred times stiffer. Each must run to the end with finite, physically
+// bounded results, or stop with a numerical_failure naming the time; none may crash or
+// return NaN silently.
+TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
+  parafsi::parallel::set_threads(1);
+  struct scene {
+    const char* name;
+    double payload_mass, initial_speed, line_stiffness;
+  };
+  for (const scene sc : {scene{"payload x10", 18.0, -1, 1}, scene{"release 30 m/s", -1, 30.0, 1},
+                         scene{"lines x100", -1, 8.0, 100}}) {
+    examples::drop::drop_config c;
+    c.resolution = "tiny";
+    c.t_end = 0.25;
+    c.quiet = true;
+    c.payload_mass = sc.payload_mass;
+    c.initial_speed = sc.initial_speed;
+    c.line_stiffness = sc.line_stiffness;
+    try {
+      const auto r = examples::drop::run_drop(c);
+      const auto& e = r.history.back();
+      std::printf("extreme %-15s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
+                  sc.name, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);
+      CHECK(e.t == doctest::Approx(0.25).epsilon(1e-12));
+      for (const auto& row : r.history)
+        for (double v : row.values())
+          if (!std::isnan(v)) REQUIRE(std::isfinite(v));  // (drag coefficient is NaN at rest)
+      const double v0 = sc.initial_speed >= 0 ? sc.initial_speed : 0.0;
+      CHECK(e.speed < v0 + 9.81 * 0.25 + 1e-9);  // the air can only slow the fall (vertical release)
+      CHECK(r.summary.F_p > 0.0);
+      CHECK(std::isfinite(r.summary.F_p));
+    } catch (const parafsi::numerical_failure& err) {
+      // Allowed outcome: a clear stop naming the time.
+      MESSAGE(sc.name << " stopped: " << err.what());
+      CHECK(std::string(err.what()).find("t = ") != std::string::npos);
+    }
+  }
+}

@@ -120,3 +120,57 @@ parafsi_example_csv_test(example_inflated_membrane_quad inflated_membrane "r,w" 
   --radius 0.5 --thickness 1e-4 --E 1e9 --nu 0.3 --pressure 40 --elements 6 --element quad)
 parafsi_example_fails(example_inflated_membrane_bad_element inflated_membrane --radius 0.5 --thickness 1e-4
   --E 1e9 --nu 0.3 --pressure 40 --element hex --out ${_ex_out}/unused.csv)
+
+# ---- drop_guide (docs/guide_drop.md): the coupled drop on its tiny grid for 0.05 s.
+#      --out names a directory: history.csv (header exact, one row per 5 ms and the start)
+#      and summary.csv (header exact, one row).
+# Helper script: run PROGRAM ARGS --out DIR, require exit code 0 and the output to match
+# EXPECT; CSVS, HEADERS and ROWS are |-separated lists of the same length: DIR/CSVS[i]
+# must start with the line HEADERS[i] and have ROWS[i] data rows.
+set(_ex_dir_check ${CMAKE_CURRENT_BINARY_DIR}/run_and_check_dir.cmake)
+file(WRITE ${_ex_dir_check} [=[
+file(REMOVE_RECURSE ${OUT})
+string(REPLACE "|" ";" ARGS "${ARGS}")
+execute_process(COMMAND ${PROGRAM} ${ARGS} --out ${OUT} RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${PROGRAM} exited with ${rc}:\n${err}")
+endif()
+if(NOT out MATCHES "${EXPECT}")
+  message(FATAL_ERROR "output does not match '${EXPECT}'")
+endif()
+string(REPLACE "|" ";" CSVS "${CSVS}")
+string(REPLACE "|" ";" HEADERS "${HEADERS}")
+string(REPLACE "|" ";" ROWS "${ROWS}")
+foreach(csv header rows IN ZIP_LISTS CSVS HEADERS ROWS)
+  if(NOT EXISTS ${OUT}/${csv})
+    message(FATAL_ERROR "${PROGRAM} wrote no ${OUT}/${csv}")
+  endif()
+  file(STRINGS ${OUT}/${csv} lines)
+  list(LENGTH lines n)
+  list(GET lines 0 first)
+  if(NOT first STREQUAL header)
+    message(FATAL_ERROR "${OUT}/${csv}: header '${first}', expected '${header}'")
+  endif()
+  math(EXPR got "${n} - 1")
+  if(NOT got EQUAL rows)
+    message(FATAL_ERROR "${OUT}/${csv}: ${got} data rows, expected ${rows}")
+  endif()
+endforeach()
+]=])
+
+# parafsi_example_dir_test(NAME PROGRAM CSVS HEADERS ROWS EXPECT args...), lists |-separated.
+function(parafsi_example_dir_test name program csvs headers rows expect)
+  list(JOIN ARGN "|" _args)
+  add_test(NAME ${name}
+    COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:${program}> "-DARGS=${_args}" -DOUT=${_ex_out}/${name}
+            "-DCSVS=${csvs}" "-DHEADERS=${headers}" "-DROWS=${rows}" "-DEXPECT=${expect}" -P ${_ex_dir_check})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 120 LABELS examples ENVIRONMENT "OMP_NUM_THREADS=1")
+endfunction()
+
+parafsi_example_dir_test(example_drop_guide drop_guide "history.csv|summary.csv"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "11|1" "rows=11 t=0\\.0500 s" --t-end 0.05)
+parafsi_example_test(example_drop_guide_help drop_guide --help)
+parafsi_example_fails(example_drop_guide_bad_t_end drop_guide --t-end -1 --out ${_ex_out}/unused_drop_guide)

@@ -64,6 +64,7 @@ struct drop_config {
   double t_end = 6.0, history_every = 0.005;
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;  // growth 0: preset
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
+  double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
   double payload_mass = -1;       ///< override of the payload mass (kg), < 0 = scene
@@ -405,7 +406,11 @@ inline drop_result run_drop(const drop_config& c) {
     };
     const auto& fab = S.fabric;
     const pf::porosity::ergun law{fab.alpha, fab.beta, fab.thickness};
-    if (c.coupling == "embedded") return run(pf::coupling::embedded{law});
+    if (c.coupling == "embedded") {
+      pf::coupling::embedded_options eo;
+      eo.impedance = c.impedance;
+      return run(pf::coupling::embedded{law, eo});
+    }
     pf::coupling::penalty_options po;
     po.pfac = c.pfac;
     po.stiffening = c.stiffening;

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
+  double impedance = 1.0;
   double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
   std::string packed = "scene", box = "follow";
   int threads = 0;
@@ -63,7 +64,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"coarse", "medium", "fine", "tiny"}))
       ->capture_default_str();
   app.add_option("--t-end", t_end, "simulated time (s)")->check(CLI::Range(1e-4, 100.0))->capture_default_str();
-  app.add_option("--coupling", coupling, "fluid-structure coupling: penalty (the paper's) or embedded")
+  app.add_option("--coupling", coupling,
+                 "fluid-structure coupling: penalty (the paper's) or embedded (leak-free; impedance-stabilised)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
       ->capture_default_str();
   app.add_option("--out", out, "output directory")->capture_default_str();
@@ -105,6 +107,10 @@ int main(int argc, char** argv) {
                  "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
+  app.add_option("--impedance", impedance,
+                 "embedded: impedance (added-mass) stabilisation factor, 0 = off (light fabric is unstable without)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   app.add_option("--payload-mass", payload_mass, "override: payload mass (kg); default: the scene's")
       ->check(CLI::Range(1e-3, 1e5));
   app.add_option("--line-stiffness", line_stiffness, "multiplies EA of the lines, riser and tapes")
@@ -126,20 +132,6 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1000.0));
   int rc = 0;
   if (!examples::parse(app, argc, argv, rc)) return rc;
-  if (coupling == "embedded" && !std::getenv("PARAFSI_DROP_EMBEDDED")) {
-    // Measured: on the tiny drop grid the embedded coupling blows up at t = 0.0134 s:
-    // fabric node speeds jump from 16 m/s to 2.5e3 m/s within three fluid steps (the
-    // penalty run of the same scene stays at 18 m/s). The light fabric under explicit
-    // face-pressure loads is the added-mass limit of partitioned coupling: one cell of air
-    // per unit area weighs rho*h = 0.24 kg/m^2 (tiny) / 0.12 (coarse) against the fabric's
-    // 0.05 kg/m^2. The path stays compiled; PARAFSI_DROP_EMBEDDED=1 runs it (and the
-    // stall guard stops it). See docs/validation.md.
-    std::fprintf(stderr,
-                 "parachute_drop: error: --coupling embedded is not available for the drop yet (light fabric: "
-                 "the explicit face-pressure load is added-mass unstable, see docs/validation.md); use --coupling "
-                 "penalty\n");
-    return 2;
-  }
   if (threads > 0) parafsi::parallel::set_threads(threads);
 
   return examples::guarded("parachute_drop", [&]() -> int {
@@ -164,6 +156,7 @@ int main(int argc, char** argv) {
     c.element = h_element;
     c.initial_speed = initial_speed;
     c.payload_mass = payload_mass;
+    c.impedance = impedance;
     c.line_stiffness = line_stiffness;
     c.modulus_scale = modulus_scale;
     c.packed = packed;

@@ -65,6 +65,7 @@ struct drop_config {
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;  // growth 0: preset
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
+  double pgs_alpha = 1.0;  ///< pressure-gradient scaling α (fluid/pressure_scaling.hpp), 1 = off
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
   double payload_mass = -1;       ///< override of the payload mass (kg), < 0 = scene
@@ -138,7 +139,12 @@ inline drop_result run_drop(const drop_config& c) {
     const auto ax = pf::fluid::axis::refined(-half, half, -0.6 * D0, 0.6 * D0, h, R.growth);
     const auto az = pf::fluid::axis::refined(zlo, zhi, std::max(zlo, rz0), std::min(zhi, rz1), h, R.growth);
     pf::fluid::rectilinear_grid grid{ax, ax, az};
-    const pf::fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, P.air_pressure};
+    // Pressure-gradient scaling: the air is held at p∞/α² (sound speed c/α); outputs show
+    // physical pressures p∞ + (q − p∞/α²).
+    const pf::fluid::pressure_gradient_scaling pgs{c.pgs_alpha};
+    pgs.validate();
+    const double p_offset = pgs.pressure_offset(P.air_pressure);
+    const pf::fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};
     auto bc = pf::boundary::set::all(pf::boundary::far_field{air.rho, air.u, air.p});
     bc.layer = {3, 0.5};
     pf::frame::follow_payload follow;
@@ -253,7 +259,7 @@ inline drop_result run_drop(const drop_config& c) {
             const Eigen::Vector3d xi(g.centre(0, i), g.centre(1, j0), g.centre(2, k));
             const Eigen::Vector3d x = pose.X + pose.R * xi;
             os << xi.x() << ',' << xi.z() << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << w.rho << ','
-               << w.p << ',' << u.norm() << ',' << (u - vp).norm() << ',' << (dudz - dwdx) << '\n';
+               << w.p + p_offset << ',' << u.norm() << ',' << (u - vp).norm() << ',' << (dudz - dwdx) << '\n';
           }
         std::ofstream on(c.out + "/" + name + "_nodes.csv");
         on.precision(8);
@@ -304,7 +310,9 @@ inline drop_result run_drop(const drop_config& c) {
           std::snprintf(nm, sizeof nm, "%09.5f", s.time());
           const std::string fs = c.out + "/vtk/structure_" + nm + ".vtu", ff = c.out + "/vtk/fluid_" + nm + ".vts";
           io::write_vtu(fs, s.structure());
-          io::write_vts(ff, s.fluid());
+          io::vtk_options vo;
+          vo.pressure_offset = p_offset;
+          io::write_vts(ff, s.fluid(), vo);
           pvd->add(s.time(), ff, 0);
           pvd->add(s.time(), fs, 1);
           next_vtk += c.vtk_every;
@@ -329,10 +337,10 @@ inline drop_result run_drop(const drop_config& c) {
       if (!c.quiet)
         std::fprintf(stderr,
                      "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%ldx%ldx%ld, h = %.4g m near the canopy), "
-                     "%ld structure nodes, %zu triangles, coupling %s, %s box, t_end %.3g s\n",
+                     "%ld structure nodes, %zu triangles, coupling %s, %s box, PGS alpha %g, t_end %.3g s\n",
                      P.name.c_str(), fabric_name.c_str(), c.resolution.c_str(), ncells, long(grid.n(0)),
                      long(grid.n(1)), long(grid.n(2)), h, long(nd.size()), S.triangles.size(), c.coupling.c_str(),
-                     c.box.c_str(), c.t_end);
+                     c.box.c_str(), c.pgs_alpha, c.t_end);
       if (c.restart.empty()) record();
       observers();
       examples::progress prog("parachute_drop", c.t_end, c.quiet);

@@ -32,8 +32,20 @@ std::vector<double> parse_list(const std::string& s) {
   std::vector<double> v;
   std::stringstream ss(s);
   std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) v.push_back(std::stod(item));
+  while (std::getline(ss, item, ',')) {
+    if (item.empty()) continue;
+    std::size_t used = 0;
+    double t = NAN;
+    try {
+      t = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || !std::isfinite(t) || t < 0)
+      throw parafsi::invalid_input("parachute_drop: --slice-times: '" + item +
+                                   "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
+    v.push_back(t);
+  }
   return v;
 }
 
@@ -48,6 +60,7 @@ int main(int argc, char** argv) {
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
   double impedance = 1.0;
+  double pgs_alpha = 1.0;
   double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
   std::string packed = "scene", box = "follow";
   int threads = 0;
@@ -130,6 +143,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--fixed-fall", fixed_fall, "fixed box: fall length (m) it must hold below the release point")
       ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--pgs", pgs_alpha,
+                 "pressure-gradient scaling alpha: sound speed c/alpha, steps alpha times longer (1 = off)")
+      ->check(CLI::Range(1.0, 64.0))
+      ->capture_default_str();
   int rc = 0;
   if (!examples::parse(app, argc, argv, rc)) return rc;
   if (threads > 0) parafsi::parallel::set_threads(threads);
@@ -157,6 +174,7 @@ int main(int argc, char** argv) {
     c.initial_speed = initial_speed;
     c.payload_mass = payload_mass;
     c.impedance = impedance;
+    c.pgs_alpha = pgs_alpha;
     c.line_stiffness = line_stiffness;
     c.modulus_scale = modulus_scale;
     c.packed = packed;

@@ -16,6 +16,7 @@
 #include "frame/translate.hpp"
 #include "gas.hpp"
 #include "grid.hpp"
+#include "pressure_scaling.hpp"
 #include "reconstruction/first_order.hpp"
 #include "reconstruction/muscl.hpp"
 #include "reference/vortices.hpp"

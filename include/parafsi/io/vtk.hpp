@@ -77,6 +77,9 @@ enum class vtk_encoding { ascii, binary };
 
 struct vtk_options {
   vtk_encoding encoding = vtk_encoding::binary;
+  /// Added to every fluid pressure written (Pa): e.g. fluid::pressure_gradient_scaling's
+  /// pressure_offset(p∞), so a scaled run shows physical pressures. 0 = as stored.
+  double pressure_offset = 0.0;
 };
 
 struct vtu_options : vtk_options {
@@ -371,7 +374,7 @@ void write_vts(const std::filesystem::path& path, const Solver& s, const vtk_opt
         const auto w = s.primitive(i, j, k);
         rho.push_back(w.rho);
         vel.insert(vel.end(), {w.u.x, w.u.y, w.u.z});
-        p.push_back(w.p);
+        p.push_back(w.p + opt.pressure_offset);
         if constexpr (Solver::has_eddy_viscosity) mut.push_back(s.eddy_viscosity()[g.index(i, j, k)]);
       }
   const std::vector<double> vort = vorticity(s);

@@ -48,24 +48,29 @@ struct resolution {
   double growth = 1.3;    ///< cell growth factor outside the refined block
 };
 
-/// coarse: element D0/20, cell D0/10, growth 1.3 (17 576 cells); medium: D0/40, D0/20,
-/// growth 1.12 (about the paper's finest validation mesh, ≈ 1.6e5 cells); fine: D0/60,
-/// D0/30, growth 1.1; tiny (tests): D0/10, D0/5, growth 1.3.
+/// draft: element D0/20, cell D0/10, growth 1.3 (17 576 cells; the packed canopy's mouth
+/// spans two cells, too few for the embedded coupling to fill it reliably); coarse (the
+/// default): D0/30, D0/15, growth 1.2 (54 872 cells); medium: D0/40, D0/20, growth 1.12
+/// (about the paper's finest validation mesh, ≈ 1.5e5 cells); fine: D0/60, D0/30, growth
+/// 1.1 (≈ 4.4e5 cells); tiny (tests): D0/10, D0/5, growth 1.3. docs/validation.md §8.
 inline resolution preset(const std::string& name) {
+  if (name == "draft") return {0.05, 0.10, 1.3};
   if (name == "medium") return {0.025, 0.05, 1.12};
   if (name == "fine") return {0.0167, 0.0333, 1.1};
   if (name == "tiny") return {0.1, 0.2, 1.3};
-  return {0.05, 0.10, 1.3};
+  pf::require(name == "coarse", "parachute_drop: unknown resolution '", name,
+              "' (draft, coarse, medium, fine or tiny)");
+  return {0.0333, 0.0667, 1.2};
 }
 
 struct drop_config {
-  std::string canopy = "paper", fabric = "mat544", resolution = "coarse", coupling = "penalty";
-  std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at coarse/tiny)
+  std::string canopy = "paper", fabric = "mat544", resolution = "coarse", coupling = "embedded";
+  std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
   double t_end = 6.0, history_every = 0.005;
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;  // growth 0: preset
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
-  double pgs_alpha = 1.0;  ///< pressure-gradient scaling α (fluid/pressure_scaling.hpp), 1 = off
+  double pgs_alpha = 8.0;  ///< pressure-gradient scaling α (fluid/pressure_scaling.hpp), 1 = off
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
   double payload_mass = -1;       ///< override of the payload mass (kg), < 0 = scene
@@ -161,7 +166,7 @@ inline drop_result run_drop(const drop_config& c) {
       return go(make_fluid(viscosity, follow));
     };
     auto with_fluid = [&](auto&& go) -> drop_result {
-      if (c.viscosity == "inviscid" || (c.viscosity == "auto" && (c.resolution == "coarse" || c.resolution == "tiny")))
+      if (c.viscosity == "inviscid" || (c.viscosity == "auto" && (c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny")))
         return with_frame(pf::viscosity::inviscid{}, go);
       return with_frame(visc, go);
     };

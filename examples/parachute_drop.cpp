@@ -1,7 +1,7 @@
 // parachute_drop: the paper's parachute–payload drop (section 4) end to end.
 //
 //   parachute_drop [--canopy paper|c9] [--fabric mat544|mat59225|mat509]
-//                  [--resolution coarse|medium|fine] [--t-end SECONDS]
+//                  [--resolution draft|coarse|medium|fine] [--t-end SECONDS]
 //                  [--coupling penalty|embedded] [--out DIR] [--vtk-every SECONDS]
 //                  [--checkpoint-every SECONDS] [--restart FILE] [--threads N]
 //
@@ -12,8 +12,10 @@
 // frame::follow_payload translates it with the payload mass centre and turns its −z axis
 // to the payload velocity, tracked every step. Far field + sponge on all six faces; cells
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
-// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at coarse); penalty
-// coupling with the fabric's Ergun law (docs/coupling.md).
+// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at
+// draft/coarse), pressure-gradient scaling α = 8 (--pgs); embedded coupling with the
+// fabric's Ergun law and its impedance stabilisation, or the paper's penalty coupling
+// (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
 // following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
 // --payload-mass, --initial-speed (extreme scenes).
@@ -53,14 +55,14 @@ std::vector<double> parse_list(const std::string& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Parachute-payload drop (the paper's section 4 scene): coupled fluid, canopy, lines and payload"};
-  std::string canopy = "paper", fabric = "mat544", res_name = "coarse", coupling = "penalty", out = "out/drop";
+  std::string canopy = "paper", fabric = "mat544", res_name = "coarse", coupling = "embedded", out = "out/drop";
   std::string restart, slice_times = "0.1,0.2,0.3,0.5,1,2,4,6";
   double t_end = 6.0, vtk_every = 0, checkpoint_every = 0, history_every = 0.005;
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
   double impedance = 1.0;
-  double pgs_alpha = 1.0;
+  double pgs_alpha = 8.0;
   double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
   std::string packed = "scene", box = "follow";
   int threads = 0;
@@ -73,8 +75,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"mat544", "mat59225", "mat509"}))
       ->capture_default_str();
   app.add_option("--resolution", res_name,
-                 "coarse (element D0/20, cell D0/10), medium (D0/40, D0/20), fine (D0/60, D0/30); tiny for tests")
-      ->check(CLI::IsMember({"coarse", "medium", "fine", "tiny"}))
+                 "draft (element D0/20, cell D0/10), coarse (D0/30, D0/15), medium (D0/40, D0/20), fine (D0/60, D0/30); tiny for tests")
+      ->check(CLI::IsMember({"draft", "coarse", "medium", "fine", "tiny"}))
       ->capture_default_str();
   app.add_option("--t-end", t_end, "simulated time (s)")->check(CLI::Range(1e-4, 100.0))->capture_default_str();
   app.add_option("--coupling", coupling,
@@ -117,7 +119,7 @@ int main(int argc, char** argv) {
   app.add_option("--initial-speed", initial_speed, "override: release speed (m/s); default: the scene's")
       ->check(CLI::Range(0.0, 200.0));
   app.add_option("--viscosity", viscosity,
-                 "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at coarse, else constant)")
+                 "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
   app.add_option("--impedance", impedance,

@@ -53,18 +53,22 @@ TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
 
 // Checkpoint/restart of the whole drop program: a run to 0.1 s that writes a checkpoint
 // at 0.06 s, and a second run restarted from that checkpoint (with the first run's
-// history up to 0.06 s), must produce the same history bit for bit: the stepper state
+// history up to 0.06 s), must produce the same history bit for bit, with either coupling: the stepper state
 // (fluid, box frame, structure, penalty penetrations, clock) and the driver's output
 // schedule are fully restored.
 TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identical") {
   namespace fs = std::filesystem;
   parafsi::parallel::set_threads(1);
   const fs::path base = fs::temp_directory_path() / "parafsi_drop_restart";
+  for (const char* coupling : {"penalty", "embedded"}) {
+  CAPTURE(coupling);
   fs::remove_all(base);
   fs::create_directories(base / "a");
   fs::create_directories(base / "b");
   examples::drop::drop_config c;
   c.resolution = "tiny";
+  c.coupling = coupling;
+  c.pgs_alpha = std::string(coupling) == "embedded" ? 8.0 : 1.0;  // the program's default and the paper's method
   c.t_end = 0.1;
   c.initial_speed = 8.0;
   c.quiet = true;
@@ -93,10 +97,12 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   CHECK(cont.summary.t_p == full.summary.t_p);
   // The restarted run took only the steps after the checkpoint.
   CHECK(cont.steps == full.steps);  // the step count is part of the restored state
+  }
   fs::remove_all(base);
 }
 
-// Extreme scenes on the tiny grid (0.25 s): ten times the payload, a release at 30 m/s
+// Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the
+// program's default (embedded, PGS α = 8): ten times the payload, a release at 30 m/s
 // and lines a hundred times stiffer. Each must run to the end with finite, physically
 // bounded results, or stop with a numerical_failure naming the time; none may crash or
 // return NaN silently.
@@ -108,8 +114,12 @@ TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
   };
   for (const scene sc : {scene{"payload x10", 18.0, -1, 1}, scene{"release 30 m/s", -1, 30.0, 1},
                          scene{"lines x100", -1, 8.0, 100}}) {
+    for (const char* coupling : {"penalty", "embedded"}) {
+    CAPTURE(coupling);
     examples::drop::drop_config c;
     c.resolution = "tiny";
+    c.coupling = coupling;
+    c.pgs_alpha = std::string(coupling) == "embedded" ? 8.0 : 1.0;
     c.t_end = 0.25;
     c.quiet = true;
     c.payload_mass = sc.payload_mass;
@@ -118,8 +128,8 @@ TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
     try {
       const auto r = examples::drop::run_drop(c);
       const auto& e = r.history.back();
-      std::printf("extreme %-15s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
-                  sc.name, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);
+      std::printf("extreme %-15s %-8s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
+                  sc.name, coupling, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);
       CHECK(e.t == doctest::Approx(0.25).epsilon(1e-12));
       for (const auto& row : r.history)
         for (double v : row.values())
@@ -132,6 +142,7 @@ TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
       // Allowed outcome: a clear stop naming the time.
       MESSAGE(sc.name << " stopped: " << err.what());
       CHECK(std::string(err.what()).find("t = ") != std::string::npos);
+    }
     }
   }
 }

@@ -15,7 +15,10 @@
 /// |ξx|, |ξy| ≤ 0.6 D0, ξz from 0.55 Ls above the confluence to 0.55 D0 above Ls (the
 /// canopy), growing by `growth` per cell outwards; far field + 3-cell sponge on all six
 /// faces. HLLC-LM + MUSCL (van Leer), SSP-RK2; constant μ or inviscid (`viscosity`).
-/// Coupling: penalty (PFAC, stiffening λ) with the fabric's Ergun law, or embedded.
+/// Pressure-gradient scaling α (`pgs_alpha`; 0 = auto: 8 with the embedded coupling, 1 with
+/// penalty, whose spring stiffness γp/α² it would soften): the air held at p/α².
+/// Coupling: embedded (default) or penalty (PFAC, stiffening λ), both with the fabric's
+/// Ergun law.
 #pragma once
 #include "example_common.hpp"
 
@@ -70,7 +73,7 @@ struct drop_config {
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;  // growth 0: preset
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
-  double pgs_alpha = 8.0;  ///< pressure-gradient scaling α (fluid/pressure_scaling.hpp), 1 = off
+  double pgs_alpha = 0.0;  ///< pressure-gradient scaling α ≥ 1 (fluid/pressure_scaling.hpp), 1 = off; 0 = auto
   double cell = 0, element = 0;   ///< overrides of the preset (/ D0), 0 = preset
   double initial_speed = -1;      ///< override of the scene's release speed (m/s), < 0 = scene
   double payload_mass = -1;       ///< override of the payload mass (kg), < 0 = scene
@@ -146,8 +149,14 @@ inline drop_result run_drop(const drop_config& c) {
     pf::fluid::rectilinear_grid grid{ax, ax, az};
     // Pressure-gradient scaling: the air is held at p∞/α² (sound speed c/α); outputs show
     // physical pressures p∞ + (q − p∞/α²).
-    const pf::fluid::pressure_gradient_scaling pgs{c.pgs_alpha};
+    // α = 0: auto, 8 for the embedded coupling (docs/validation.md §8), 1 for penalty (its
+    // spring stiffness PFAC γp A/h would fall as 1/α²).
+    const double alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
+    const pf::fluid::pressure_gradient_scaling pgs{alpha};
     pgs.validate();
+    // Guard: the scaled flow's Mach number αv/c, from the payload speed at every output.
+    const double c_air = std::sqrt(1.4 * P.air_pressure / P.air_density);
+    bool warned_mach = false;
     const double p_offset = pgs.pressure_offset(P.air_pressure);
     const pf::fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};
     auto bc = pf::boundary::set::all(pf::boundary::far_field{air.rho, air.u, air.p});
@@ -281,6 +290,14 @@ inline drop_result run_drop(const drop_config& c) {
       std::vector<io::drop_history_row> previous;
       if (!c.restart.empty()) {
         io::load_checkpoint(c.restart, s);
+        {
+          // The checkpoint holds the fluid, not the far field: a run restarted with another
+          // α (or scene pressure) would put the restored air against a different ambient.
+          const double q = s.fluid().primitive(0, 0, 0).p, q_inf = pgs.scaled_ambient(P.air_pressure);
+          pf::require(q > 0.5 * q_inf && q < 2.0 * q_inf, "parachute_drop: checkpoint '", c.restart,
+                      "' holds air at ", q, " Pa in a corner cell, but this run's ambient is ", q_inf,
+                      " Pa (PGS alpha ", alpha, "): restart with the --pgs and scene of the run that wrote it");
+        }
         std::ifstream in(c.out + "/history.csv");
         std::string line;
         std::getline(in, line);
@@ -334,6 +351,14 @@ inline drop_result run_drop(const drop_config& c) {
       auto& history = res.history;
       auto record = [&] {
         history.push_back(observe());
+        if (alpha > 1.0 && !warned_mach && !c.quiet && alpha * history.back().speed / c_air > 0.3) {
+          warned_mach = true;
+          std::fprintf(stderr,
+                       "\nparachute_drop: warning: at t = %.3g s the payload moves at %.3g m/s, alpha M = %.2f > 0.3 with "
+                       "PGS alpha %g: compressibility errors grow as (alpha M)^2; use --pgs %.0f or lower for this speed\n",
+                       history.back().t, history.back().speed, alpha * history.back().speed / c_air, alpha,
+                       std::max(1.0, std::floor(0.2 * c_air / history.back().speed)));
+        }
         if (files) {
           io::write_history_row(hist, history.back());
           hist.flush();
@@ -345,7 +370,7 @@ inline drop_result run_drop(const drop_config& c) {
                      "%ld structure nodes, %zu triangles, coupling %s, %s box, PGS alpha %g, t_end %.3g s\n",
                      P.name.c_str(), fabric_name.c_str(), c.resolution.c_str(), ncells, long(grid.n(0)),
                      long(grid.n(1)), long(grid.n(2)), h, long(nd.size()), S.triangles.size(), c.coupling.c_str(),
-                     c.box.c_str(), c.pgs_alpha, c.t_end);
+                     c.box.c_str(), alpha, c.t_end);
       if (c.restart.empty()) record();
       observers();
       examples::progress prog("parachute_drop", c.t_end, c.quiet);

@@ -13,7 +13,7 @@
 // to the payload velocity, tracked every step. Far field + sponge on all six faces; cells
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
 // --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at
-// draft/coarse), pressure-gradient scaling α = 8 (--pgs); embedded coupling with the
+// draft/coarse), pressure-gradient scaling α = 8 with embedded, 1 with penalty (--pgs); embedded coupling with the
 // fabric's Ergun law and its impedance stabilisation, or the paper's penalty coupling
 // (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
@@ -26,7 +26,10 @@
 // summary row on stdout at the end.
 #include "drop_driver.hpp"
 
+#include <cmath>
 #include <cstdlib>
+#include <exception>
+#include <string>
 
 namespace {
 
@@ -62,7 +65,7 @@ int main(int argc, char** argv) {
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
   double h_cell = 0, h_element = 0, initial_speed = -1;
   double impedance = 1.0;
-  double pgs_alpha = 8.0;
+  double pgs_alpha = 0.0;
   double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
   std::string packed = "scene", box = "follow";
   int threads = 0;
@@ -146,8 +149,9 @@ int main(int argc, char** argv) {
   app.add_option("--fixed-fall", fixed_fall, "fixed box: fall length (m) it must hold below the release point")
       ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--pgs", pgs_alpha,
-                 "pressure-gradient scaling alpha: sound speed c/alpha, steps alpha times longer (1 = off)")
-      ->check(CLI::Range(1.0, 64.0))
+                 "pressure-gradient scaling alpha >= 1: sound speed c/alpha, steps alpha times longer (1 = off; "
+                 "default 0 = auto: 8 with embedded, 1 with penalty)")
+      ->check(CLI::Range(0.0, 64.0))
       ->capture_default_str();
   int rc = 0;
   if (!examples::parse(app, argc, argv, rc)) return rc;

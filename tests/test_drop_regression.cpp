@@ -95,8 +95,23 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   CHECK(cont.history.back().t == full.history.back().t);
   CHECK(cont.summary.F_p == full.summary.F_p);
   CHECK(cont.summary.t_p == full.summary.t_p);
-  // The restarted run took only the steps after the checkpoint.
-  CHECK(cont.steps == full.steps);  // the step count is part of the restored state
+  // The step count is part of the restored state: the restarted run ends at the same count.
+  CHECK(cont.steps == full.steps);
+  }
+  // A checkpoint restarted with another pressure-gradient scaling is refused, naming both
+  // pressures (the checkpoint holds the air, the far field comes from the flags).
+  {
+    examples::drop::drop_config c;
+    c.resolution = "tiny";
+    c.coupling = "embedded";
+    c.pgs_alpha = 1.0;
+    c.t_end = 0.01;
+    c.initial_speed = 8.0;
+    c.quiet = true;
+    c.out = (base / "a").string();
+    c.restart = (base / "a" / "checkpoint.ckpt").string();  // written by the embedded, alpha = 8 run
+    CHECK_THROWS_WITH_AS(examples::drop::run_drop(c), doctest::Contains("restart with the --pgs and scene"),
+                         parafsi::invalid_input);
   }
   fs::remove_all(base);
 }

@@ -23,6 +23,7 @@ pgs_run gresho_scaled(double mach, double alpha, int n, double t_end) {
   const fluid::pressure_gradient_scaling pgs{alpha};
   pgs.validate();
   const fluid::reference::gresho_vortex physical{mach}, scaled{pgs.effective_mach(mach)};
+  // The vortex's reference pressure (its centre value) plays the ambient's role.
   const double p_inf = 1.0 / (physical.gamma * mach * mach);
   // The scaled initial state must be the physical one with the ambient divided by α².
   const auto s0 = scaled(0.61, 0.43), p0 = physical(0.61, 0.43);

@@ -21,7 +21,8 @@
 /// coupling's stiffness, methods §4.4) is α² softer. Keep αM ≲ 0.2; measure the effect on
 /// every answer that matters (docs/fluid_theory.md §11, docs/validation.md).
 /// The temperature q/(ρR) is α² lower: use it only with a constant (or temperature-free)
-/// viscosity.
+/// viscosity. Density perturbations are those of the scaled gas (α² larger than the
+/// physical ones); only pressure has a mapping back.
 ///
 /// References: Ramshaw J.D., O'Rourke P.J., Stein L.R. (1985) J. Comput. Phys. 58:361
 ///   (pressure gradient scaling); Wang Y., Trouvé A. (2004) Combust. Flame 139:37 (PGS

@@ -21,6 +21,10 @@
 namespace parafsi::structure::impl {
 
 inline constexpr index_t chunk = 1024;  ///< items per work chunk (multiple of every pack width)
+/// Fewer chunks than this run serially: a structure substep's loops are short (a chunk of
+/// 1024 triangles is tens of µs), and waking a thread costs as much (measured on the
+/// default drop, 1488 triangles: two threads made the structure phase 2× slower).
+inline constexpr index_t min_parallel_chunks = 4;
 
 inline index_t chunk_count(index_t n) { return (n + chunk - 1) / chunk; }
 
@@ -28,8 +32,8 @@ inline index_t chunk_count(index_t n) { return (n + chunk - 1) / chunk; }
 template <class F>
 inline void for_each_chunk(index_t n, F&& f) {
   const index_t nc = chunk_count(n);
-  if (nc <= 1) {  // one chunk: no parallel region (its fork/join would dominate)
-    if (n > 0) f(0, n, 0);
+  if (nc < min_parallel_chunks) {  // few chunks: no parallel region (its fork/join would dominate)
+    for (index_t c = 0; c < nc; ++c) f(c * chunk, std::min(n, (c + 1) * chunk), c);
     return;
   }
   parallel::for_range(0, nc, [&](index_t c) { f(c * chunk, std::min(n, (c + 1) * chunk), c); });

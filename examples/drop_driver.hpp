@@ -155,7 +155,7 @@ inline drop_result run_drop(const drop_config& c) {
     const pf::fluid::pressure_gradient_scaling pgs{alpha};
     pgs.validate();
     // Guard: the scaled flow's Mach number αv/c, from the payload speed at every output.
-    const double c_air = std::sqrt(1.4 * P.air_pressure / P.air_density);
+    const double c_air = pf::gas::ideal{}.sound_speed(P.air_density, P.air_pressure);  // the solver's gas
     bool warned_mach = false;
     const double p_offset = pgs.pressure_offset(P.air_pressure);
     const pf::fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};

@@ -100,6 +100,20 @@ class explicit_stepper {
   }
   const stepper_phase_times& timings() const noexcept { return times_; }
   void reset_timings() noexcept { times_ = {}; }
+  /// Checkpoint (io/archive.hpp): the clock and the coupling's state; the fluid and the
+  /// structure are written by their own serialize (io::save_checkpoint gives each its
+  /// section).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.check("coupling_type", std::string(Coupling::name()), "the coupling");
+    ar("time", self.t_);
+    ar("steps", self.steps_);
+    ar("last_substeps", self.last_m_);
+    ar("previous_substep", self.prev_substep_);
+    ar("coupling", self.coupling_);
+    if constexpr (Archive::loading)
+      if (self.steps_ < 0) ar.fail("the stepper's step count is ", self.steps_);
+  }
   /// Upper bound on substeps per fluid step; more is an error naming the cause.
   long max_substeps = 10000;
 

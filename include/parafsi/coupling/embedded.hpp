@@ -152,6 +152,15 @@ class embedded {
   }
   /// Area of the blocking elements (m², current geometry at the last exchange).
   double coupled_area() const { return area_; }
+  /// Checkpoint (io/archive.hpp; after attach): nothing carries over between steps (the
+  /// faces, loads and impedance terms are rebuilt by every exchange); the set-up is compared.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.check("porosity", std::string(Porosity::name()), "the porosity law");
+    ar.check("impedance", self.opt_.impedance, "the impedance factor");
+    ar.check("triangles", std::int64_t(self.tris_.size()), "the number of coupled triangles");
+    ar.check("open", std::int64_t(self.open_list_.size()), "the number of open elements");
+  }
 
   // ------------------------------------------------------------- stepper hooks
   template <class Fluid, class Asm>

@@ -132,6 +132,19 @@ class penalty {
             c, " or value ", d);
     d_[std::size_t(c)] = d;
   }
+  /// Checkpoint (io/archive.hpp; after attach): the coupling settings (compared), the
+  /// penetration of every point (state the next step reads) and the cumulative energy.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.check("porosity", std::string(Porosity::name()), "the porosity law");
+    ar.check("pfac", self.opt_.pfac, "the penalty factor PFAC");
+    ar.check("damping_ratio", self.opt_.damping_ratio, "the coupling damping ratio");
+    ar.check("stiffening", self.opt_.stiffening, "the penalty stiffening");
+    ar.check("fluid_cap", self.opt_.fluid_cap, "the fluid-side stiffness cap");
+    ar.check("points", std::int64_t(self.d_.size()), "the number of penalty coupling points");
+    ar("penetration", self.d_);
+    ar("coupling_energy", self.diag_.coupling_energy);
+  }
   /// Total through-flow Σ_e (m³/s) and coupled area (m²) at the last substep.
   double total_through_flow() const {
     double q = 0;

@@ -72,7 +72,11 @@ struct gT0 {}; struct gT1 {}; struct gT2 {};
 struct mu_t { static constexpr const char* name = "mu_t"; };
 struct wall_distance { static constexpr const char* name = "wall_distance"; };
 // Sources (per unit volume and time).
-struct s_mx {}; struct s_my {}; struct s_mz {}; struct s_E {}; struct s_rho {};
+struct s_mx { static constexpr const char* name = "s_mx"; };
+struct s_my { static constexpr const char* name = "s_my"; };
+struct s_mz { static constexpr const char* name = "s_mz"; };
+struct s_E { static constexpr const char* name = "s_E"; };
+struct s_rho { static constexpr const char* name = "s_rho"; };
 struct sponge_sigma {};
 }  // namespace field
 
@@ -399,6 +403,51 @@ class solver {
     frame_.plan(pose_, t_, dt);
     pose_.advance(dt);
     t_ += dt;
+  }
+
+  // ------------------------------------------------------------------ checkpoint
+  /// Checkpoint (io/archive.hpp; Self = const solver on save, solver on load). Signature
+  /// first (policies, ghosts, grid faces, gas), then everything the next step reads:
+  /// time, step count, pose, the frame policy's state, the conserved fields (by tag
+  /// name, ghosts and SIMD padding included), the sources if enabled, and μ_t and the
+  /// wall distance when the closure keeps them (stable_dt reads μ_t).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.check("type", self.name(), "the solver type");
+    ar.check("ghosts", std::int64_t(ng), "the number of ghost layers");
+    for (int d = 0; d < 3; ++d)
+      ar.check("grid.axis" + std::to_string(d), self.grid_.axis_of(d).faces,
+               [d](const std::vector<double>& file, const std::vector<double>& mine) -> std::string {
+                 if (file.size() != mine.size())
+                   return detail::concat("grid axis ", d, " has ", index_t(file.size()) - 1,
+                                         " cells in the file but ", index_t(mine.size()) - 1, " in this solver");
+                 for (std::size_t i = 0; i < file.size(); ++i)
+                   if (file[i] != mine[i])
+                     return detail::concat("grid axis ", d, " face ", i, " is at ", file[i], " in the file but ",
+                                           mine[i], " in this solver");
+                 return {};
+               });
+    ar.check("total_cells", self.grid_.total_cells(), "the cell count incl. ghosts");
+    ar.check("field_length", std::int64_t(simd::padded(std::size_t(self.grid_.total_cells())) + simd::width),
+             "the field length (cells + SIMD padding; another SIMD width?)");
+    ar.check("gas.gamma", self.gas_.gamma, "gas gamma");
+    ar.check("gas.R", self.gas_.R, "gas constant R");
+    ar("time", self.t_);
+    ar("steps", self.steps_);
+    ar("pose.X", self.pose_.X);
+    ar("pose.R", self.pose_.R);
+    ar("pose.V", self.pose_.V);
+    ar("pose.Omega", self.pose_.Omega);
+    ar("frame", self.frame_);
+    ar.fields("conserved", self.U_);
+    bool sources = self.sources_.has_value();
+    ar("sources", sources);
+    if constexpr (Archive::loading) {
+      if (sources) self.enable_sources();
+      else if (self.sources_) self.sources_->resize(self.grid_.total_cells(), 0.0);  // none in the file: zero
+    }
+    if (sources) ar.fields("sources", *self.sources_);
+    if constexpr (has_eddy_viscosity) ar.fields("turbulence", self.turb_store_);
   }
 
  private:

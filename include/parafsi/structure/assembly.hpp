@@ -34,6 +34,7 @@
 #include <Eigen/Geometry>
 
 #include "../core/error.hpp"
+#include "../core/simd.hpp"
 #include "central_difference.hpp"
 #include "energy.hpp"
 #include "nodes.hpp"
@@ -232,6 +233,69 @@ class assembly {
   double evaluate_forces(Loads&& loads = {}) {
     if (nodes_.needs_finalize()) finalize();
     return compute_phase<true>(loads);
+  }
+
+  /// Checkpoint (io/archive.hpp; Self = const assembly on save, assembly on load). In
+  /// order: the signature (type, node count, each part's name and element count); the
+  /// constraint kinds and point masses (nodes::serialize), after which a load finalizes
+  /// the scene if needed; a digest of each element part's connectivity, rest lengths and
+  /// reference areas (scene data, compared); the node arrays by tag name (x … fez,
+  /// padding included); each part's own state (its serialize: membrane pressures, rigid
+  /// bodies); the integrator settings; the clock and the energy ledger. Elements hold
+  /// no other history (total-Lagrangian membranes, elastic + damped cables).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    if constexpr (Archive::saving)
+      require(!self.nodes_.needs_finalize(),
+              "io::save_checkpoint: the assembly is not finalized (call finalize() or step first)");
+    auto each_part = [&](auto&& f) {
+      [&]<std::size_t... I>(std::index_sequence<I...>) {
+        (f(std::string("part") + std::to_string(I), std::get<I>(self.parts_)), ...);
+      }(std::make_index_sequence<part_count>{});
+    };
+    const index_t N = self.nodes_.size();
+    ar.check("type", name(), "the assembly type");
+    ar.check("nodes", N, "the node count");
+    ar.check("field_length", std::int64_t(simd::padded(std::size_t(N)) + simd::width),
+             "the node field length (SIMD padding; another SIMD width?)");
+    each_part([&](const std::string& k, auto& p) {
+      ar.check(k + ".name", std::string(p.name()), k);
+      if constexpr (requires { p.element(index_t(0)); })
+        ar.check(k + ".elements", p.size(), k + " (" + p.name() + ") element count");
+    });
+    ar("nodes", self.nodes_);
+    if constexpr (Archive::loading)
+      if (self.nodes_.needs_finalize()) self.finalize();  // masses, scatter maps, reference geometry
+    each_part([&](const std::string& k, auto& p) {
+      if constexpr (requires { p.element(index_t(0)); })
+        ar.check_digest(k + ".reference", k + " (" + p.name() + "): connectivity, rest lengths or reference areas",
+                        [&](auto put) {
+                          for (index_t e = 0; e < p.size(); ++e) {
+                            for (auto n : p.element(e)) put(n);
+                            if constexpr (requires { p.rest_length(e); }) put(p.rest_length(e));
+                            if constexpr (requires { p.reference_area(e); }) put(p.reference_area(e));
+                          }
+                        });
+    });
+    ar.fields("node", self.nodes_.data());
+    each_part([&](const std::string& k, auto& p) {
+      using P = std::remove_cvref_t<decltype(p)>;
+      if constexpr (requires { P::serialize(ar, p); }) ar(k, p);
+    });
+    ar("gravity", self.cd_.gravity);
+    ar("mass_damping", self.cd_.mass_damping);
+    ar("tssf", self.cd_.tssf);
+    ar("time", self.t_);
+    ar("steps", self.steps_);
+    ar("previous_step", self.dt_prev_);
+    ar("track_energy", self.track_);
+    ar("energy.kinetic", self.ledger_.kinetic);
+    ar("energy.strain", self.ledger_.strain);
+    ar("energy.damping", self.ledger_.damping);
+    ar("energy.external", self.ledger_.external);
+    if constexpr (Archive::loading)
+      if (self.steps_ < 0 || self.dt_prev_ < 0)
+        ar.fail("the clock holds ", self.steps_, " steps and a previous step of ", self.dt_prev_, " s");
   }
 
  private:

@@ -50,6 +50,11 @@ class attachment {
   Body& body() noexcept { return body_; }
   const Body& body() const noexcept { return body_; }
   std::size_t size() const noexcept { return points_.size(); }
+  /// Checkpoint (io/archive.hpp): the body's state (the attachment points are scene data).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar("body", self.body_);
+  }
 
   void finalize(nodes& nd) {
     for (const auto& a : points_) {

@@ -93,6 +93,11 @@ class membrane_tri {
   /// Per-element pressure (Pa), one value per triangle.
   void set_pressure(std::span<const double> p) { impl::set_element_pressure(name(), p_, n_, p); }
   double* pressure() noexcept { return p_.data(); }
+  /// Checkpoint (io/archive.hpp): the per-element pressure load (all slots, padding included).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.array("pressure", self.p_.data(), self.p_.size());
+  }
 
   // ---------------------------------------------------------------- set-up
   /// Reference geometry, fibre frame, lumped mass, scatter map. Called by assembly.

@@ -39,8 +39,12 @@ struct fz { static constexpr const char* name = "fz"; };
 struct m { static constexpr const char* name = "m"; };
 struct minv { static constexpr const char* name = "minv"; };
 // Energy bookkeeping: damping and applied (external) parts of f, filled only when tracking.
-struct fdx {}; struct fdy {}; struct fdz {};
-struct fex {}; struct fey {}; struct fez {};
+struct fdx { static constexpr const char* name = "fdx"; };
+struct fdy { static constexpr const char* name = "fdy"; };
+struct fdz { static constexpr const char* name = "fdz"; };
+struct fex { static constexpr const char* name = "fex"; };
+struct fey { static constexpr const char* name = "fey"; };
+struct fez { static constexpr const char* name = "fez"; };
 }  // namespace field
 
 using node_fields = meta::list<field::x, field::y, field::z, field::vx, field::vy, field::vz, field::fx,
@@ -189,6 +193,29 @@ class nodes {
   }
   storage& data() noexcept { return s_; }
   const storage& data() const noexcept { return s_; }
+
+  /// Checkpoint (io/archive.hpp): the constraint kinds and point masses, which may change
+  /// during a run. A change on load marks the set for finalize; the node arrays follow
+  /// (assembly::serialize writes them by tag name after the masses are final).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    std::vector<constraint> kind = self.kind_;
+    std::vector<double> point_mass = self.point_mass_;
+    ar("constraints", kind);
+    ar("point_masses", point_mass);
+    if constexpr (Archive::loading) {
+      for (std::size_t i = 0; i < kind.size(); ++i) {
+        if (unsigned(kind[i]) > unsigned(constraint::attached))
+          ar.fail("node ", i, " has an unknown constraint kind ", unsigned(kind[i]));
+        if (!(point_mass[i] >= 0.0)) ar.fail("node ", i, " has a negative point mass ", point_mass[i]);
+      }
+      if (kind != self.kind_ || point_mass != self.point_mass_) {
+        self.kind_ = std::move(kind);
+        self.point_mass_ = std::move(point_mass);
+        self.dirty_ = true;
+      }
+    }
+  }
 
  private:
   void check(index_t i, const char* what) const {

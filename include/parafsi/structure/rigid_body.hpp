@@ -334,6 +334,27 @@ class rigid_body {
     s_ = s;
     update_inverse();
   }
+  /// Checkpoint (io/archive.hpp): every field of state(); a load goes through set_state.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    rigid_body_state s = self.state();
+    ar("mass", s.mass);
+    ar("inertia", s.inertia);
+    ar("com_body", s.com_body);
+    ar("x_com", s.x_com);
+    ar("q", s.q);
+    ar("q_half", s.q_half);
+    ar("p", s.p);
+    ar("l", s.l);
+    ar("omega_body", s.omega_body);
+    ar("force_com", s.force_com);
+    ar("force_points", s.force_points);
+    ar("moment_origin", s.moment_origin);
+    ar("dt_prev", s.dt_prev);
+    ar("time", s.time);
+    ar("steps", s.steps);
+    if constexpr (Archive::loading) self.set_state(s);
+  }
 
   /// exp(θ) = (cos(|θ|/2), sin(|θ|/2) θ/|θ|), the unit quaternion of the rotation vector θ.
   static Eigen::Quaterniond exp_map(const Eigen::Vector3d& theta) {

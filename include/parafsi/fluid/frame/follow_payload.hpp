@@ -63,6 +63,19 @@ struct follow_payload {
       p.V = (target_position - R_next * offset - p.X) / dt;
     }
   }
+
+  /// Checkpoint (io/archive.hpp): settings, target and offset (a restart continues with
+  /// the values of the run that wrote the file).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar("axis", self.axis);
+    ar("min_speed", self.min_speed);
+    ar("max_rate", self.max_rate);
+    ar("turn", self.turn);
+    ar("target_position", self.target_position);
+    ar("target_velocity", self.target_velocity);
+    ar("offset", self.offset);
+  }
 };
 
 }  // namespace parafsi::frame

@@ -17,6 +17,12 @@ struct rigid {
     p.V = velocity;
     p.Omega = angular_velocity;
   }
+  /// Checkpoint (io/archive.hpp): the velocities.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar("velocity", self.velocity);
+    ar("angular_velocity", self.angular_velocity);
+  }
 };
 
 }  // namespace parafsi::frame

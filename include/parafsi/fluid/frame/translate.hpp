@@ -16,6 +16,11 @@ struct translate {
     p.V = velocity;
     p.Omega.setZero();
   }
+  /// Checkpoint (io/archive.hpp): the velocity.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar("velocity", self.velocity);
+  }
 };
 
 }  // namespace parafsi::frame

@@ -2,8 +2,11 @@
 // are refused with messages naming what differs.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -35,6 +38,19 @@ void write_bytes(const fs::path& p, const std::vector<unsigned char>& b) {
   out.write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
 }
 bool same_bits(const double* a, const double* b, std::size_t n) { return std::memcmp(a, b, n * sizeof(double)) == 0; }
+// File layout: 19-byte magic, u32 version, u32 byte order, u64 payload length, payload, u64 checksum.
+constexpr std::size_t payload_at = 19 + 16;
+/// Replace the entry name `from` by `to` (same length) and re-seal the checksum: a file
+/// that is intact but written with another field name.
+std::vector<unsigned char> rename_entry(std::vector<unsigned char> b, const std::string& from, const std::string& to) {
+  REQUIRE(from.size() == to.size());
+  const auto it = std::search(b.begin(), b.end(), from.begin(), from.end());
+  REQUIRE(it != b.end());
+  std::copy(to.begin(), to.end(), it);
+  const std::uint64_t sum = pf::io::ckpt::fnv1a(b.data() + payload_at, b.size() - payload_at - 8);
+  std::memcpy(b.data() + b.size() - 8, &sum, 8);
+  return b;
+}
 
 // ---- fluid: viscous + Smagorinsky on a stretched grid, a box following a turning
 // target, a source field; the step comes from stable_dt (reads μ_t).
@@ -147,7 +163,9 @@ TEST_CASE("checkpoint: a fluid run restored mid-way continues bit-identically") 
   auto again = make_fluid();
   pf::io::load_checkpoint(p, again);
   CHECK(again.time() > 0);
+  CHECK(again.steps() == 6);  // the fluid's step count is restored
   fluid_steps(again, 6);
+  CHECK(again.steps() == ref.steps());
   require_same_fluid(ref, again);
   CHECK(ref.pose().R.isApprox(again.pose().R));
   CHECK_FALSE(ref.pose().R.isIdentity(1e-6));  // the box did turn
@@ -234,7 +252,7 @@ TEST_CASE("checkpoint: an embedded-coupling stepper restored mid-way continues b
 
 TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-identically") {
   pf::parallel::set_threads(1);
-  auto make = [] {
+  auto make = [](double pfac = 1.0) {
     auto grid = pf::fluid::rectilinear_grid::uniform({8, 8, 8}, {0, 0, 0}, {0.4, 0.4, 0.4});
     pf::fluid::solver fl{grid, pf::boundary::set::all(pf::boundary::periodic{})};
     fl.fill_uniform({1.2, {0, 0, 0}, 101325.0});
@@ -246,7 +264,7 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
     st::assembly as{std::move(nd), st::membrane_tri{tm, st::material::fabric<>::isotropic(1e5, 0.3, 0.05, 1e-4)}};
     as.integrator().gravity = {0, 0, 0};
     pf::coupling::penalty_options o;
-    o.pfac = 1.0;
+    o.pfac = pfac;
     return pf::explicit_stepper{std::move(fl), std::move(as), pf::coupling::penalty{pf::porosity::ergun{1e9, 1e5, 1e-4}, o}};
   };
   auto ref = make();
@@ -262,6 +280,7 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
   auto again = make();
   pf::io::load_checkpoint(p, again);
   CHECK(again.steps() == 5);
+  CHECK(again.fluid().steps() == 5);
   for (double dt : dts) again.step(dt);
   CHECK(again.time() == ref.time());
   CHECK(again.steps() == ref.steps());
@@ -274,6 +293,11 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
   for (std::size_t f = 0; f < 6; ++f) CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
   for (std::size_t c = 0; c < ref.coupling().points().size(); ++c)
     CHECK(ref.coupling().penetration(index_t(c)) == again.coupling().penetration(index_t(c)));
+  CHECK(ref.coupling().diagnostics().coupling_energy == again.coupling().diagnostics().coupling_energy);
+  // The coupling's settings are part of the scene: another PFAC is refused by name.
+  auto stiffer = make(2.0);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, stiffer),
+                       doctest::Contains("the penalty factor PFAC is 1 in the file but 2 here"), pf::io::checkpoint_error);
 }
 
 TEST_CASE("checkpoint: truncated, corrupted, foreign and mismatched files are refused with clear messages") {
@@ -334,4 +358,116 @@ TEST_CASE("checkpoint: truncated, corrupted, foreign and mismatched files are re
   pf::io::load_checkpoint(p, fresh, a2);
   CHECK(fresh.time() == s.time());
   CHECK(a2.steps() == 3);
+}
+
+TEST_CASE("checkpoint: format version 1 is refused naming both versions") {
+  pf::parallel::set_threads(1);
+  auto s = make_fluid();
+  const fs::path p = scratch("v2.ckpt");
+  pf::io::save_checkpoint(p, s);
+  auto b = bytes_of(p);
+  std::uint32_t version;
+  std::memcpy(&version, b.data() + 19, 4);
+  CHECK(version == 2);
+  CHECK(pf::io::checkpoint_version == 2);
+  version = 1;
+  std::memcpy(b.data() + 19, &version, 4);
+  const fs::path v1 = scratch("v1.ckpt");
+  write_bytes(v1, b);
+  auto fresh = make_fluid();
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(v1, fresh),
+                       doctest::Contains("checkpoint format version 1 (entries by position); this build reads version 2"),
+                       pf::io::checkpoint_error);
+  CHECK_THROWS_WITH_AS(pf::io::read_checkpoint_info(v1), doctest::Contains("format version 1"), pf::io::checkpoint_error);
+  CHECK(fresh.time() == 0.0);
+}
+
+TEST_CASE("checkpoint: fields are stored by their tag names; another name is refused naming both") {
+  pf::parallel::set_threads(1);
+  auto s = make_fluid();
+  fluid_steps(s, 1);
+  auto a = make_structure();
+  structure_steps(a, 2);
+  const fs::path p = scratch("named.ckpt");
+  pf::io::save_checkpoint(p, s, a);
+  const auto good = bytes_of(p);
+  // Every conserved field, source, μ_t and node field appears under its tag name.
+  const std::string text(good.begin(), good.end());
+  for (const char* n : {"conserved.rho", "conserved.mx", "conserved.my", "conserved.mz", "conserved.E", "sources.s_mx",
+                        "sources.s_rho", "turbulence.mu_t", "frame.target_position", "node.x", "node.vz", "node.minv",
+                        "node.fez", "part0.pressure", "part2.body.q_half", "nodes.constraints"})
+    CHECK_MESSAGE(text.find(n) != std::string::npos, n);
+
+  const fs::path bad = scratch("renamed.ckpt");
+  write_bytes(bad, rename_entry(good, "conserved.rho", "conserved.RHO"));
+  auto f2 = make_fluid();
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(bad, f2),
+                       doctest::Contains("expected entry 'conserved.rho' but found 'conserved.RHO'"),
+                       pf::io::checkpoint_error);
+  write_bytes(bad, rename_entry(good, "node.vy", "node.VY"));
+  auto a2 = make_structure();
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(bad, a2), doctest::Contains("expected entry 'node.vy' but found 'node.VY'"),
+                       pf::io::checkpoint_error);
+  // The untouched file loads, and the restored fluid and structure clocks equal the saved ones.
+  auto f3 = make_fluid();
+  auto a3 = make_structure();
+  pf::io::load_checkpoint(p, f3, a3);
+  CHECK(f3.steps() == s.steps());
+  CHECK(f3.steps() == 1);
+  CHECK(a3.steps() == 2);
+}
+
+TEST_CASE("checkpoint: a non-finite value in an intact file is refused naming the entry") {
+  pf::parallel::set_threads(1);
+  auto s = make_fluid();
+  s.conserved_storage().data(4)[s.grid().index(2, 3, 1)] = std::numeric_limits<double>::quiet_NaN();
+  const fs::path p = scratch("nan.ckpt");
+  pf::io::save_checkpoint(p, s);
+  auto fresh = make_fluid();
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, fresh),
+                       doctest::Contains("entry 'conserved.E' holds a non-finite value (nan at index"),
+                       pf::io::checkpoint_error);
+}
+
+TEST_CASE("checkpoint: a scene signature is saved and a restart with another scene is refused by name") {
+  pf::parallel::set_threads(1);
+  auto s = make_fluid();
+  pf::io::scene_signature scene;
+  scene.add("pgs_alpha", 8.0).add("payload_mass", 100.0).add("fabric", "mat544").add("line_stiffness_scale", 1.0);
+  const fs::path p = scratch("scene.ckpt");
+  pf::io::save_checkpoint(p, s, scene);
+  CHECK(pf::io::read_checkpoint_info(p).sections == std::vector<std::string>{"fluid", "scene"});
+
+  auto fresh = make_fluid();
+  pf::io::scene_signature other;
+  other.add("pgs_alpha", 8.0).add("payload_mass", 50.0).add("fabric", "mat544").add("line_stiffness_scale", 1.0);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, fresh, other),
+                       doctest::Contains("scene parameter 'payload_mass' is 100 in the file but 50 here"),
+                       pf::io::checkpoint_error);
+  pf::io::scene_signature fabric;
+  fabric.add("pgs_alpha", 8.0).add("payload_mass", 100.0).add("fabric", "mat509").add("line_stiffness_scale", 1.0);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, fresh, fabric),
+                       doctest::Contains("scene parameter 'fabric' is 'mat544' in the file but 'mat509' here"),
+                       pf::io::checkpoint_error);
+  pf::io::scene_signature fewer;
+  fewer.add("pgs_alpha", 8.0).add("payload_mass", 100.0).add("fabric", "mat544");
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, fresh, fewer),
+                       doctest::Contains("scene parameter 'line_stiffness_scale' is in the file but not in this run"),
+                       pf::io::checkpoint_error);
+  pf::io::scene_signature more = scene;
+  more.add("modulus_scale", 10.0);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, fresh, more),
+                       doctest::Contains("scene parameter 'modulus_scale' is in this run's scene signature but not in "
+                                         "the file"),
+                       pf::io::checkpoint_error);
+  CHECK_THROWS_AS(scene.add("pgs_alpha", 6.0), pf::invalid_input);  // a parameter is given once
+  CHECK_THROWS_AS(pf::io::scene_signature{}.add("alpha", std::numeric_limits<double>::quiet_NaN()), pf::invalid_input);
+
+  pf::io::load_checkpoint(p, fresh, scene);  // the same scene loads
+  CHECK(fresh.time() == s.time());
+  // A file without a scene section: a restart that gives one is refused, naming the section.
+  const fs::path bare = scratch("no_scene.ckpt");
+  pf::io::save_checkpoint(bare, s);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(bare, fresh, scene), doctest::Contains("has no section 'scene'"),
+                       pf::io::checkpoint_error);
 }

@@ -126,12 +126,17 @@ int main(int argc, char** argv) {
   app.add_option("--cell", c.cell, "override: fluid cell size around the canopy / D0")
       ->check(finite)
       ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--element", c.element, "override: canopy element size / D0")->check(finite)->check(CLI::Range(0.0, 1.0));
+  app.add_option("--element", c.element, "override: canopy element size / D0")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--cfl", c.cfl, "CFL number of the fluid step")
       ->check(finite)
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
-  app.add_option("--pfac", c.pfac, "penalty factor PFAC")->check(finite)->check(CLI::Range(1e-3, 1e3))->capture_default_str();
+  app.add_option("--pfac", c.pfac, "penalty factor PFAC")
+      ->check(finite)
+      ->check(CLI::Range(1e-3, 1e3))
+      ->capture_default_str();
   app.add_option("--stiffening", c.stiffening, "penalty stiffening lambda (0 = off)")
       ->check(finite)
       ->check(CLI::Range(0.0, 10.0))

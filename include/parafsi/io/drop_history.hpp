@@ -99,9 +99,9 @@ class drop_observer {
     r.drag_coefficient = drag_coefficient(weight_, air_density_, r.speed, nominal_area_);
     for (index_t i = 0; i < nd.size(); ++i)
       if (!nd.position(i).allFinite())
-        throw numerical_failure(
-            parafsi::detail::concat("parachute_drop: structure node ", i, " has a non-finite position at t = ", t, " s"),
-            long(i), t);
+        throw numerical_failure(parafsi::detail::concat("parachute_drop: structure node ", i,
+                                                        " has a non-finite position at t = ", t, " s"),
+                                long(i), t);
     return r;
   }
 

@@ -56,7 +56,8 @@ struct drop_resolution {
     if (name == "medium") return {0.025, 0.05, 1.12};
     if (name == "fine") return {0.0167, 0.0333, 1.1};
     if (name == "tiny") return {0.1, 0.2, 1.3};
-    require(name == "coarse", "model::drop_resolution: unknown resolution '", name, "' (draft, coarse, medium, fine or tiny)");
+    require(name == "coarse", "model::drop_resolution: unknown resolution '", name,
+            "' (draft, coarse, medium, fine or tiny)");
     return {0.0333, 0.0667, 1.2};
   }
 };

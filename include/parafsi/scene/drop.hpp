@@ -90,7 +90,7 @@ struct drop_config {
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
   double membrane_damping = 0.05;    ///< membrane damping ratio of its highest mode
   double impedance = 1.0;            ///< embedded: impedance (added-mass) stabilisation factor ζ
-  double pgs_alpha = 0.0;            ///< pressure-gradient scaling α ≥ 1 (fluid/pressure_scaling.hpp), 1 = off; 0 = auto
+  double pgs_alpha = 0.0;            ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
   double cell = 0, element = 0;      ///< overrides of the resolution (/ D0), 0 = the resolution's
   double initial_speed = -1;         ///< override of the scene's release speed (m/s), < 0 = scene
   double payload_mass = -1;          ///< override of the payload mass (kg), <= 0 = scene
@@ -193,10 +193,13 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   if (c.payload_mass > 0) P.payload.mass = c.payload_mass;
   for (auto* l : {&P.line, &P.skirt_tape, &P.vent_tape, &P.band}) l->stiffness_scale *= c.line_stiffness;
   P.moduli.modulus_scale *= c.modulus_scale;
-  if (c.packed == "reduced_radius") P.shape = model::packed_shape::reduced_radius(c.packed_parameter > 0 ? c.packed_parameter : 0.2);
+  if (c.packed == "reduced_radius")
+    P.shape = model::packed_shape::reduced_radius(c.packed_parameter > 0 ? c.packed_parameter : 0.2);
   else if (c.packed == "star_fold")
-    P.shape = model::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi / 180.0);
-  else if (c.packed == "constructed") P.shape = model::packed_shape::constructed();
+    P.shape = model::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi /
+                                             180.0);
+  else if (c.packed == "constructed")
+    P.shape = model::packed_shape::constructed();
   su.fixed_box = c.box == "fixed";
   P.canopy.element_size = R.element * D0;
   su.scene = model::build_drop_scene(P);
@@ -211,8 +214,8 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   // α = 0: auto, 8 for the embedded coupling (docs/validation.md §8), 1 for penalty (its
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
-  su.viscous = !(c.viscosity == "inviscid" ||
-                 (c.viscosity == "auto" && (c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny")));
+  const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
+  su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
 }
 
@@ -313,8 +316,8 @@ class drop_run {
     require(q > 0.5 * q_inf && q < 2.0 * q_inf, "parachute_drop: checkpoint '", c_.restart, "' holds air at ", q,
             " Pa in a corner cell, but this run's ambient is ", q_inf, " Pa (PGS alpha ", su_.alpha,
             "): restart with the --pgs and scene of the run that wrote it");
-    require(c_.t_end > s_.time() + 1e-12, "parachute_drop: t_end ", c_.t_end, " s is not after the time of checkpoint '",
-            c_.restart, "', ", s_.time(), " s: nothing to run");
+    require(c_.t_end > s_.time() + 1e-12, "parachute_drop: t_end ", c_.t_end,
+            " s is not after the time of checkpoint '", c_.restart, "', ", s_.time(), " s: nothing to run");
     std::vector<io::drop_history_row> previous;
     if (files_) previous = io::read_drop_history(out() / "history.csv", s_.time() + 1e-12);
     if (!c_.quiet)

@@ -54,6 +54,17 @@ decltype(auto) dispatch(const std::string& flux, const std::string& limiter, F&&
 }
 
 // ---------------------------------------------------------------- options
+/// Validator for floating-point options: refuses NaN and ±inf, naming the value (CLI11
+/// prefixes the option's name). Put it before a CLI::Range, which lets NaN through
+/// (every comparison with NaN is false):  ->check(examples::finite)->check(CLI::Range(a, b)).
+inline const CLI::Validator finite{[](std::string& s) {
+                                     double v = 0;
+                                     if (!CLI::detail::lexical_cast(s, v)) return "'" + s + "' is not a number";
+                                     if (!std::isfinite(v)) return "value " + s + " is not a finite number";
+                                     return std::string();
+                                   },
+                                   ""};
+
 /// Options every example shares.
 struct common_options {
   std::string flux = "hllc_lm";
@@ -75,6 +86,7 @@ inline void add_limiter_option(CLI::App& app, common_options& o) {
 }
 inline void add_run_options(CLI::App& app, common_options& o) {
   app.add_option("--cfl", o.cfl, "CFL number of the stable step, in (0, 1]")
+      ->check(finite)
       ->check(CLI::Range(1e-6, 1.0))
       ->capture_default_str();
   app.add_option("--threads", o.threads,

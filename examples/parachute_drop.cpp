@@ -24,12 +24,21 @@
 // mid-plane slices slice_<t>.csv (+ slice_<t>_nodes.csv) at --slice-times. Definitions:
 // include/parafsi/io/drop_summary.hpp and docs/validation.md. Progress on stderr; the
 // summary row on stdout at the end.
-#include "drop_driver.hpp"
+//
+// The run is scene::run_drop (include/parafsi/scene/drop.hpp); the flags bind directly to
+// the fields of scene::drop_config, whose defaults are the program's. Every floating
+// flag refuses NaN and ±inf (examples::finite); a write that fails (a full disk, a
+// missing directory) stops the program with a message naming the file and exit code 1.
+#include "example_common.hpp"
+
+#include <parafsi/scene/drop.hpp>
 
 #include <cmath>
-#include <cstdlib>
+#include <cstdio>
 #include <exception>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -47,110 +56,140 @@ std::vector<double> parse_list(const std::string& s) {
       used = 0;
     }
     if (used != item.size() || !std::isfinite(t) || t < 0)
-      throw parafsi::invalid_input("parachute_drop: --slice-times: '" + item +
-                                   "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
+      throw CLI::ValidationError("--slice-times", "'" + item +
+                                 "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
     v.push_back(t);
   }
   return v;
+}
+
+std::string join_list(const std::vector<double>& v) {
+  std::ostringstream os;
+  for (std::size_t i = 0; i < v.size(); ++i) os << (i ? "," : "") << v[i];
+  return os.str();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Parachute-payload drop (the paper's section 4 scene): coupled fluid, canopy, lines and payload"};
-  std::string canopy = "paper", fabric = "mat544", res_name = "coarse", coupling = "embedded", out = "out/drop";
-  std::string restart, slice_times = "0.1,0.2,0.3,0.5,1,2,4,6";
-  double t_end = 6.0, vtk_every = 0, checkpoint_every = 0, history_every = 0.005;
-  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5, growth = 0, cfl = 0.9;
-  double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0, membrane_damping = 0.05;
-  double h_cell = 0, h_element = 0, initial_speed = -1;
-  double impedance = 1.0;
-  double pgs_alpha = 0.0;
-  double payload_mass = -1, line_stiffness = 1, modulus_scale = 1, packed_parameter = -1, fixed_fall = 0;
-  std::string packed = "scene", box = "follow";
+  parafsi::scene::drop_config c;  // the defaults
   int threads = 0;
-  bool quiet = false;
-  std::string viscosity = "auto";
-  app.add_option("--canopy", canopy, "scene: paper (section 4) or c9 (28-gore, 28 ft, deployed at 13.4 m/s)")
+  const CLI::Validator& finite = examples::finite;
+  app.add_option("--canopy", c.canopy, "scene: paper (section 4) or c9 (28-gore, 28 ft, deployed at 13.4 m/s)")
       ->check(CLI::IsMember({"paper", "c9"}))
       ->capture_default_str();
-  app.add_option("--fabric", fabric, "canopy fabric of the paper's Table 2 (paper canopy)")
+  app.add_option("--fabric", c.fabric, "canopy fabric of the paper's Table 2 (paper canopy)")
       ->check(CLI::IsMember({"mat544", "mat59225", "mat509"}))
       ->capture_default_str();
-  app.add_option("--resolution", res_name,
+  app.add_option("--resolution", c.resolution,
                  "draft (element D0/20, cell D0/10), coarse (D0/30, D0/15), medium (D0/40, D0/20), fine (D0/60, D0/30); tiny for tests")
       ->check(CLI::IsMember({"draft", "coarse", "medium", "fine", "tiny"}))
       ->capture_default_str();
-  app.add_option("--t-end", t_end, "simulated time (s)")->check(CLI::Range(1e-4, 100.0))->capture_default_str();
-  app.add_option("--coupling", coupling,
+  app.add_option("--t-end", c.t_end, "simulated time (s)")->check(finite)->check(CLI::Range(1e-4, 100.0))->capture_default_str();
+  app.add_option("--coupling", c.coupling,
                  "fluid-structure coupling: penalty (the paper's) or embedded (leak-free; impedance-stabilised)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
       ->capture_default_str();
-  app.add_option("--out", out, "output directory")->capture_default_str();
-  app.add_option("--vtk-every", vtk_every, "VTK output interval (s)")->check(CLI::Range(0.0, 100.0));
-  app.add_option("--checkpoint-every", checkpoint_every, "checkpoint interval (s)")->check(CLI::Range(0.0, 100.0));
-  app.add_option("--restart", restart, "restart from this checkpoint file");
+  app.add_option("--out", c.out, "output directory")->capture_default_str();
+  app.add_option("--vtk-every", c.vtk_every, "VTK output interval (s)")->check(finite)->check(CLI::Range(0.0, 100.0));
+  app.add_option("--checkpoint-every", c.checkpoint_every, "checkpoint interval (s)")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--restart", c.restart, "restart from this checkpoint file");
   app.add_option("--threads", threads, "OpenMP threads (0: OMP_NUM_THREADS)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  app.add_option("--history-every", history_every, "history.csv row interval (s), at most 5 ms")
+  app.add_option("--history-every", c.history_every, "history.csv row interval (s), at most 5 ms")
+      ->check(finite)
       ->check(CLI::Range(1e-5, 0.005))
       ->capture_default_str();
-  app.add_option("--slice-times", slice_times, "times of the mid-plane slices (comma list, s; empty: none)")
+  app.add_option_function<std::string>(
+         "--slice-times", [&c](const std::string& s) { c.slice_times = parse_list(s); },
+         "times of the mid-plane slices (comma list, s; empty: none)")
+      ->default_str(join_list(c.slice_times));
+  app.add_option("--box-width", c.box_width, "box cross-section side / D0")
+      ->check(finite)
+      ->check(CLI::Range(2.0, 50.0))
       ->capture_default_str();
-  app.add_option("--box-width", box_width, "box cross-section side / D0")->check(CLI::Range(2.0, 50.0))->capture_default_str();
-  app.add_option("--box-length", box_length, "box length / D0")->check(CLI::Range(3.0, 100.0))->capture_default_str();
-  app.add_option("--box-ahead", box_ahead, "box length ahead of the payload / D0")
+  app.add_option("--box-length", c.box_length, "box length / D0")
+      ->check(finite)
+      ->check(CLI::Range(3.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--box-ahead", c.box_ahead, "box length ahead of the payload / D0")
+      ->check(finite)
       ->check(CLI::Range(0.3, 50.0))
       ->capture_default_str();
-  app.add_option("--growth", growth, "cell growth factor outside the refined region (default: the resolution's)")
+  app.add_option("--growth", c.growth, "cell growth factor outside the refined region (default: the resolution's)")
+      ->check(finite)
       ->check(CLI::Range(1.0, 2.0));
-  app.add_option("--cell", h_cell, "override: fluid cell size around the canopy / D0")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--element", h_element, "override: canopy element size / D0")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--cfl", cfl, "CFL number of the fluid step")->check(CLI::Range(0.01, 1.0))->capture_default_str();
-  app.add_option("--pfac", pfac, "penalty factor PFAC")->check(CLI::Range(1e-3, 1e3))->capture_default_str();
-  app.add_option("--stiffening", stiffening, "penalty stiffening lambda (0 = off)")
+  app.add_option("--cell", c.cell, "override: fluid cell size around the canopy / D0")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--element", c.element, "override: canopy element size / D0")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--cfl", c.cfl, "CFL number of the fluid step")
+      ->check(finite)
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  app.add_option("--pfac", c.pfac, "penalty factor PFAC")
+      ->check(finite)
+      ->check(CLI::Range(1e-3, 1e3))
+      ->capture_default_str();
+  app.add_option("--stiffening", c.stiffening, "penalty stiffening lambda (0 = off)")
+      ->check(finite)
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
-  app.add_option("--coupling-damping", coupling_damping, "penalty damping ratio")
+  app.add_option("--coupling-damping", c.coupling_damping, "penalty damping ratio")
+      ->check(finite)
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app.add_option("--membrane-damping", membrane_damping, "membrane damping ratio (highest mode)")
+  app.add_option("--membrane-damping", c.membrane_damping, "membrane damping ratio (highest mode)")
+      ->check(finite)
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app.add_flag("--quiet", quiet, "no progress on stderr");
-  app.add_option("--initial-speed", initial_speed, "override: release speed (m/s); default: the scene's")
+  app.add_flag("--quiet", c.quiet, "no progress on stderr");
+  app.add_option("--initial-speed", c.initial_speed, "override: release speed (m/s); default: the scene's")
+      ->check(finite)
       ->check(CLI::Range(0.0, 200.0));
-  app.add_option("--viscosity", viscosity,
+  app.add_option("--viscosity", c.viscosity,
                  "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
-  app.add_option("--impedance", impedance,
+  app.add_option("--impedance", c.impedance,
                  "embedded: impedance (added-mass) stabilisation factor, 0 = off (light fabric is unstable without)")
+      ->check(finite)
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app.add_option("--payload-mass", payload_mass, "override: payload mass (kg); default: the scene's")
+  app.add_option("--payload-mass", c.payload_mass, "override: payload mass (kg); default: the scene's")
+      ->check(finite)
       ->check(CLI::Range(1e-3, 1e5));
-  app.add_option("--line-stiffness", line_stiffness, "multiplies EA of the lines, riser and tapes")
+  app.add_option("--line-stiffness", c.line_stiffness, "multiplies EA of the lines, riser and tapes")
+      ->check(finite)
       ->check(CLI::Range(1e-3, 1e4))
       ->capture_default_str();
-  app.add_option("--modulus-scale", modulus_scale, "multiplies the fabric moduli E11, E22, G12")
+  app.add_option("--modulus-scale", c.modulus_scale, "multiplies the fabric moduli E11, E22, G12")
+      ->check(finite)
       ->check(CLI::Range(1e-3, 1e3))
       ->capture_default_str();
-  app.add_option("--packed", packed, "initial packed canopy shape (scene: the scene's, reduced radius 0.2 for paper)")
+  app.add_option("--packed", c.packed, "initial packed canopy shape (scene: the scene's, reduced radius 0.2 for paper)")
       ->check(CLI::IsMember({"scene", "reduced_radius", "star_fold", "constructed"}))
       ->capture_default_str();
-  app.add_option("--packed-parameter", packed_parameter,
+  app.add_option("--packed-parameter", c.packed_parameter,
                  "reduced_radius: radial scale s (default 0.2); star_fold: seam half-angle in degrees (default 5)")
+      ->check(finite)
       ->check(CLI::Range(0.0, 89.0));
-  app.add_option("--box", box, "fluid box: follow (the paper's, moves and turns with the payload) or fixed")
+  app.add_option("--box", c.box, "fluid box: follow (the paper's, moves and turns with the payload) or fixed")
       ->check(CLI::IsMember({"follow", "fixed"}))
       ->capture_default_str();
-  app.add_option("--fixed-fall", fixed_fall, "fixed box: fall length (m) it must hold below the release point")
+  app.add_option("--fixed-fall", c.fixed_fall, "fixed box: fall length (m) it must hold below the release point")
+      ->check(finite)
       ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--pgs", pgs_alpha,
+  app.add_option("--pgs", c.pgs_alpha,
                  "pressure-gradient scaling alpha >= 1: sound speed c/alpha, steps alpha times longer (1 = off; "
                  "default 0 = auto: 8 with embedded, 1 with penalty)")
+      ->check(finite)
       ->check(CLI::Range(0.0, 64.0))
       ->capture_default_str();
   int rc = 0;
@@ -158,42 +197,11 @@ int main(int argc, char** argv) {
   if (threads > 0) parafsi::parallel::set_threads(threads);
 
   return examples::guarded("parachute_drop", [&]() -> int {
-    examples::drop::drop_config c;
-    c.canopy = canopy;
-    c.fabric = fabric;
-    c.resolution = res_name;
-    c.coupling = coupling;
-    c.viscosity = viscosity;
-    c.t_end = t_end;
-    c.history_every = history_every;
-    c.box_width = box_width;
-    c.box_length = box_length;
-    c.box_ahead = box_ahead;
-    c.growth = growth;
-    c.cfl = cfl;
-    c.pfac = pfac;
-    c.stiffening = stiffening;
-    c.coupling_damping = coupling_damping;
-    c.membrane_damping = membrane_damping;
-    c.cell = h_cell;
-    c.element = h_element;
-    c.initial_speed = initial_speed;
-    c.payload_mass = payload_mass;
-    c.impedance = impedance;
-    c.pgs_alpha = pgs_alpha;
-    c.line_stiffness = line_stiffness;
-    c.modulus_scale = modulus_scale;
-    c.packed = packed;
-    c.packed_parameter = packed_parameter;
-    c.box = box;
-    c.fixed_fall = fixed_fall;
-    c.slice_times = parse_list(slice_times);
-    c.out = out;
-    c.vtk_every = vtk_every;
-    c.checkpoint_every = checkpoint_every;
-    c.restart = restart;
-    c.quiet = quiet;
-    const auto r = examples::drop::run_drop(c);
+    examples::progress prog("parachute_drop", c.t_end, c.quiet);
+    const auto r = parafsi::scene::run_drop(c, [&](double t, long steps, bool done) {
+      if (done) prog.finish(t, steps);
+      else prog(t, steps);
+    });
     std::printf("%s\n%s\n", parafsi::io::drop_summary_header, r.summary.csv_row().c_str());
     return 0;
   });

@@ -183,3 +183,74 @@ parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_fabric parachute_drop --fabric nylon --out ${_ex_out}/unused_drop)
+
+# ---- parachute_drop refusals (exit code non-zero and the message naming the cause).
+# Helper script: optionally make OUT a directory whose FULL entry (a |-list of names) are
+# links to /dev/full (a device that accepts the open and fails every write with ENOSPC),
+# run PROGRAM ARGS --out OUT, require a non-zero exit code and the output (stdout and
+# stderr) to match EXPECT. ARGS without --out get --out OUT.
+set(_ex_fail_check ${CMAKE_CURRENT_BINARY_DIR}/run_and_expect_failure.cmake)
+file(WRITE ${_ex_fail_check} [=[
+file(REMOVE_RECURSE ${OUT})
+if(DEFINED FULL AND NOT FULL STREQUAL "")
+  if(NOT EXISTS /dev/full)
+    message("no /dev/full on this system: skipped")
+    return()
+  endif()
+  file(MAKE_DIRECTORY ${OUT})
+  string(REPLACE "|" ";" FULL "${FULL}")
+  foreach(name IN LISTS FULL)
+    file(CREATE_LINK /dev/full ${OUT}/${name} SYMBOLIC)
+  endforeach()
+endif()
+string(REPLACE "|" ";" ARGS "${ARGS}")
+if(NOT ARGS MATCHES "(^|;)--out(;|$)")
+  list(APPEND ARGS --out ${OUT})
+endif()
+execute_process(COMMAND ${PROGRAM} ${ARGS} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${err}")
+if(rc EQUAL 0)
+  message(FATAL_ERROR "${PROGRAM} exited with 0 where it must fail")
+endif()
+if(NOT "${out}${err}" MATCHES "${EXPECT}")
+  message(FATAL_ERROR "the message does not match '${EXPECT}'")
+endif()
+]=])
+
+# parafsi_example_refuses(NAME PROGRAM FULL EXPECT args...): FULL a |-list of files linked
+# to /dev/full in the output directory ("" for none).
+function(parafsi_example_refuses name program full expect)
+  list(JOIN ARGN "|" _args)
+  add_test(NAME ${name}
+    COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:${program}> "-DARGS=${_args}" -DOUT=${_ex_out}/${name}
+            "-DFULL=${full}" "-DEXPECT=${expect}" -P ${_ex_fail_check})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 60 LABELS examples ENVIRONMENT "OMP_NUM_THREADS=1")
+endfunction()
+
+# Write failures: history.csv or summary.csv on a full device, an --out that cannot be a
+# directory, a history.csv that is a directory.
+parafsi_example_refuses(example_parachute_drop_history_full parachute_drop "history.csv"
+  "cannot write '[^']*history\\.csv': No space left on device" --resolution tiny --t-end 0.01 --quiet)
+parafsi_example_refuses(example_parachute_drop_summary_full parachute_drop "summary.csv"
+  "cannot write '[^']*summary\\.csv': No space left on device" --resolution tiny --t-end 0.01 --quiet)
+parafsi_example_refuses(example_parachute_drop_slice_full parachute_drop "slice_00.000.csv"
+  "cannot write '[^']*slice_00\\.000\\.csv': No space left on device" --resolution tiny --t-end 0.01 --quiet
+  --slice-times 0)
+parafsi_example_refuses(example_parachute_drop_out_not_a_directory parachute_drop "" "Not a directory"
+  --resolution tiny --t-end 0.01 --quiet --out /dev/full/x)
+# Non-finite values of every floating flag, named by the flag.
+foreach(flag IN ITEMS t-end history-every box-width box-length box-ahead growth cell element cfl pfac stiffening
+                      coupling-damping membrane-damping initial-speed impedance payload-mass line-stiffness
+                      modulus-scale packed-parameter fixed-fall pgs vtk-every checkpoint-every)
+  parafsi_example_refuses(example_parachute_drop_nan_${flag} parachute_drop ""
+    "--${flag}: value nan is not a finite number" --${flag} nan)
+endforeach()
+parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
+  --t-end inf)
+# Counts from doubles: refused before anything is cast or allocated, naming the count.
+parafsi_example_refuses(example_parachute_drop_tiny_cell parachute_drop "" "would have more than 1e308 cells"
+  --cell 1e-300)
+parafsi_example_refuses(example_parachute_drop_huge_grid parachute_drop "" "would have about [0-9.e+]+ cells"
+  --cell 1e-3)
+parafsi_example_refuses(example_parachute_drop_tiny_element parachute_drop "" "would give more than 1e308 triangles"
+  --element 1e-300)

@@ -1,5 +1,5 @@
-// A short drop regression: the full coupled drop (examples/drop_driver.hpp, the code
-// path of parachute_drop) on the tiny grid (canopy elements D0/10, fluid cells D0/5
+// A short drop regression: the full coupled drop (scene::run_drop, include/parafsi/scene/
+// drop.hpp, the code path of parachute_drop) on the tiny grid (canopy elements D0/10, fluid cells D0/5
 // around the canopy), released at 8 m/s so the canopy is loaded within the 0.25 s
 // simulated. Stored values (recorded with this code) with tolerances wide enough for
 // compiler and instruction-set differences, narrow enough to catch a changed scene,
@@ -9,21 +9,24 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <string>
 
-#include "../examples/drop_driver.hpp"
+#include <parafsi/scene/drop.hpp>
 
 using doctest::Approx;
 
 TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
   parafsi::parallel::set_threads(1);
-  examples::drop::drop_config c;
+  parafsi::scene::drop_config c;
   c.resolution = "tiny";
   c.coupling = "penalty";  // the configuration the stored values were recorded with
   c.pgs_alpha = 1.0;
   c.t_end = 0.25;
   c.initial_speed = 8.0;
   c.quiet = true;
-  const auto r = examples::drop::run_drop(c);
+  c.out.clear();  // no files
+  const auto r = parafsi::scene::run_drop(c);
   REQUIRE(!r.history.empty());
   const auto& e = r.history.back();
   std::printf("drop regression: cells %ld, steps %ld, wall %.2f s\n", r.cells, r.steps, r.wall);
@@ -65,7 +68,7 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   fs::remove_all(base);
   fs::create_directories(base / "a");
   fs::create_directories(base / "b");
-  examples::drop::drop_config c;
+  parafsi::scene::drop_config c;
   c.resolution = "tiny";
   c.coupling = coupling;
   c.pgs_alpha = 0.0;  // auto: 8 with embedded (the program's default), 1 with penalty (the paper's method)
@@ -74,14 +77,14 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   c.quiet = true;
   c.out = (base / "a").string();
   c.checkpoint_every = 0.06;
-  const auto full = examples::drop::run_drop(c);
+  const auto full = parafsi::scene::run_drop(c);
 
   fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
   fs::copy_file(base / "a" / "history.csv", base / "b" / "history.csv");
   c.out = (base / "b").string();
   c.checkpoint_every = 0;
   c.restart = (base / "b" / "checkpoint.ckpt").string();
-  const auto cont = examples::drop::run_drop(c);
+  const auto cont = parafsi::scene::run_drop(c);
 
   REQUIRE(full.history.size() == 21);
   REQUIRE(cont.history.size() == full.history.size());
@@ -101,7 +104,7 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   // A checkpoint restarted with another pressure-gradient scaling is refused, naming both
   // pressures (the checkpoint holds the air, the far field comes from the flags).
   {
-    examples::drop::drop_config c;
+    parafsi::scene::drop_config c;
     c.resolution = "tiny";
     c.coupling = "embedded";
     c.pgs_alpha = 1.0;
@@ -110,7 +113,33 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
     c.quiet = true;
     c.out = (base / "a").string();
     c.restart = (base / "a" / "checkpoint.ckpt").string();  // written by the embedded, alpha = 8 run
-    CHECK_THROWS_WITH_AS(examples::drop::run_drop(c), doctest::Contains("restart with the --pgs and scene"),
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("restart with the --pgs and scene"),
+                         parafsi::invalid_input);
+    // The same scene, but t_end (0.05 s) before the checkpoint's time (0.06 s): nothing to run.
+    c.pgs_alpha = 0.0;
+    c.t_end = 0.05;
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("is not after the time of checkpoint"),
+                         parafsi::invalid_input);
+    // A bad number in the history read back on the restart is named with its file, line
+    // and column (line 3 is the row of t = 0.005 s; column 4 is z).
+    fs::remove_all(base / "b");
+    fs::create_directories(base / "b");
+    {
+      std::ifstream in(base / "a" / "history.csv");
+      std::ofstream os(base / "b" / "history.csv");
+      std::string line;
+      for (int n = 1; std::getline(in, line); ++n) {
+        if (n == 3) {
+          std::size_t p = 0;
+          for (int k = 0; k < 3; ++k) p = line.find(',', p) + 1;
+          line.insert(p, "x");
+        }
+        os << line << '\n';
+      }
+    }
+    c.t_end = 0.1;
+    c.out = (base / "b").string();
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("history.csv' line 3, column 4 (z): 'x"),
                          parafsi::invalid_input);
   }
   fs::remove_all(base);
@@ -131,17 +160,18 @@ TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
                          scene{"lines x100", -1, 8.0, 100}}) {
     for (const char* coupling : {"penalty", "embedded"}) {
     CAPTURE(coupling);
-    examples::drop::drop_config c;
+    parafsi::scene::drop_config c;
     c.resolution = "tiny";
     c.coupling = coupling;
     c.pgs_alpha = 0.0;  // auto
     c.t_end = 0.25;
     c.quiet = true;
+    c.out.clear();
     c.payload_mass = sc.payload_mass;
     c.initial_speed = sc.initial_speed;
     c.line_stiffness = sc.line_stiffness;
     try {
-      const auto r = examples::drop::run_drop(c);
+      const auto r = parafsi::scene::run_drop(c);
       const auto& e = r.history.back();
       std::printf("extreme %-15s %-8s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
                   sc.name, coupling, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);

@@ -1,13 +1,18 @@
 // The drop's observables and summary (io/drop_summary.hpp) on synthetic histories
-// with known answers.
+// with known answers; the history and summary files (io/drop_history.hpp).
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include <parafsi/io/drop_history.hpp>
 #include <parafsi/io/drop_summary.hpp>
 
 namespace io = parafsi::io;
@@ -148,4 +153,100 @@ TEST_CASE("history rows round-trip and the headers are the contract's") {
   CHECK(std::isnan(e.t_f));
   const auto s = io::summarize(synthetic(1.0, 0.01, 0.7, 5.0), "short");
   CHECK(std::isfinite(s.v_terminal));
+}
+
+// ------------------------------------------------------------------ history files
+// io/drop_history.hpp: history.csv and summary.csv through checked files, read back on a
+// restart. Known answers: the rows written are read back bit for bit (shortest round-trip
+// text); the reader keeps exactly the rows with t <= t_max; a bad number is named with
+// its file, line and column; a write to a full device is an error naming the file.
+TEST_CASE("history.csv: written through a checked file, read back bit for bit") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "parafsi_drop_history_io";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto rows = synthetic(0.1, 0.005, 0.7, 5.0, 3.0, 0.2);
+  REQUIRE(rows.size() == 21);
+  {
+    io::drop_history_writer w(dir / "history.csv");
+    for (const auto& r : rows) w.write(r);
+    w.close();
+  }
+  const auto back = io::read_drop_history(dir / "history.csv", 0.05 + 1e-12);
+  REQUIRE(back.size() == 11);  // t = 0, 0.005, ..., 0.05
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    const auto a = rows[i].values(), b = back[i].values();
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
+  }
+  CHECK(differing == 0);
+  CHECK(io::read_drop_history(dir / "missing.csv", 1.0).empty());
+
+  // A last line cut short by a killed run is ignored; complete lines are kept.
+  {
+    std::ifstream in(dir / "history.csv");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream os(dir / "cut.csv");
+    os << text.substr(0, text.size() - 7);  // the last row without its end
+  }
+  CHECK(io::read_drop_history(dir / "cut.csv", 1.0).size() == 20);
+
+  // A bad number: file, line, column and text named (line 4 = the row of t = 0.01 s).
+  auto corrupt = [&](const char* name, int line_no, const std::string& replacement) {
+    std::ifstream in(dir / "history.csv");
+    std::ofstream os(dir / name);
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) os << (n == line_no ? replacement : line) << '\n';
+  };
+  std::string row4;
+  {
+    std::ifstream in(dir / "history.csv");
+    for (int n = 1; n <= 4; ++n) std::getline(in, row4);
+  }
+  const std::size_t z0 = row4.find(',', row4.find(',', row4.find(',') + 1) + 1) + 1, z1 = row4.find(',', z0);
+  corrupt("bad.csv", 4, row4.substr(0, z0) + "1.2.3" + row4.substr(z1));
+  CHECK_THROWS_WITH_AS(io::read_drop_history(dir / "bad.csv", 1.0),
+                       doctest::Contains("bad.csv' line 4, column 4 (z): '1.2.3' is not a number"),
+                       parafsi::invalid_input);
+  corrupt("short.csv", 4, "0.01,1,2");
+  CHECK_THROWS_WITH_AS(io::read_drop_history(dir / "short.csv", 1.0),
+                       doctest::Contains("short.csv' line 4: 3 columns, expected 16"), parafsi::invalid_input);
+  corrupt("header.csv", 1, "t,x,y");
+  CHECK_THROWS_WITH_AS(io::read_drop_history(dir / "header.csv", 1.0), doctest::Contains("header.csv' line 1: header"),
+                       parafsi::invalid_input);
+
+  // summary.csv: the header and one row.
+  io::write_drop_summary(dir / "summary.csv", io::summarize(rows, "mat544"));
+  {
+    std::ifstream in(dir / "summary.csv");
+    std::string h, r, extra;
+    std::getline(in, h);
+    std::getline(in, r);
+    CHECK(h == io::drop_summary_header);
+    CHECK(r.rfind("mat544,", 0) == 0);
+    CHECK(!std::getline(in, extra));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("checked files: a failed open or write is an error naming the file and the reason") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "parafsi_checked_file";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "history.csv");  // a directory where the file should be
+  const std::string open_msg = "cannot open '" + (dir / "history.csv").string() + "': Is a directory";
+  CHECK_THROWS_WITH_AS(io::drop_history_writer(dir / "history.csv"), doctest::Contains(open_msg.c_str()),
+                       io::write_error);
+  CHECK_THROWS_WITH_AS(io::write_drop_summary(dir / "no" / "such" / "summary.csv", io::drop_summary{}),
+                       doctest::Contains("No such file or directory"), io::write_error);
+  if (fs::exists("/dev/full")) {
+    // /dev/full accepts the open and fails every write with ENOSPC: the row's flush fails.
+    io::drop_history_writer w("/dev/full");
+    CHECK_THROWS_WITH_AS(w.write(io::drop_history_row{}), doctest::Contains("cannot write '/dev/full': No space left"),
+                         io::write_error);
+    CHECK_THROWS_WITH_AS(io::write_drop_summary("/dev/full", io::drop_summary{}),
+                         doctest::Contains("cannot write '/dev/full'"), io::write_error);
+  }
+  fs::remove_all(dir);
 }

@@ -214,15 +214,107 @@ TEST_CASE("scene data plugs into the structure module as is; lumped masses match
   auto chute = st::make_drop_assembly(s, 0.05);
   for (index_t i = 0; i < s.node_count(); ++i)
     CHECK(chute.node_set().mass(i) == doctest::Approx(s.lumped_mass[std::size_t(i)]).epsilon(1e-12));
+  // The parts by name are the parts by position (0 membrane, 1-5 cables, 6 payload).
+  CHECK(static_cast<const void*>(&st::canopy(chute)) == &chute.part<0>());
+  CHECK(static_cast<const void*>(&st::suspension_lines(chute)) == &chute.part<1>());
+  CHECK(static_cast<const void*>(&st::riser(chute)) == &chute.part<2>());
+  CHECK(static_cast<const void*>(&st::skirt_tape(chute)) == &chute.part<3>());
+  CHECK(static_cast<const void*>(&st::vent_tape(chute)) == &chute.part<4>());
+  CHECK(static_cast<const void*>(&st::radial_bands(chute)) == &chute.part<5>());
+  CHECK(static_cast<const void*>(&st::payload(chute)) == &chute.part<6>());
+  const st::drop_assembly& cchute = chute;
+  CHECK(&st::payload(cchute).body() == &st::payload(chute).body());
+  CHECK(st::riser(chute).size() == index_t(s.cable(md::cable_kind::riser).segments.size()));
   // The body received the hanging node's lumped mass.
-  CHECK(chute.part<6>().body().mass() ==
+  CHECK(st::payload(chute).body().mass() ==
         doctest::Approx(s.payload.mass + s.lumped_mass[std::size_t(s.suspension.hanging_point)]).epsilon(1e-12));
   const double dt = chute.stable_dt();
   std::printf("assembly from the scene: stable structural step %.3e s\n", dt);
   CHECK(dt > 1e-6);
   for (int n = 0; n < 50; ++n) chute.step(dt);
-  CHECK(std::isfinite(chute.part<6>().body().position().z()));
+  CHECK(std::isfinite(st::payload(chute).body().position().z()));
   // Free fall for 50 steps: everything falls together (no strain yet from a reduced-radius start).
   const double t = chute.time();
-  CHECK(chute.part<6>().body().position().z() == doctest::Approx(35.0 - 0.5 * 9.81 * t * t).epsilon(1e-6));
+  CHECK(st::payload(chute).body().position().z() == doctest::Approx(35.0 - 0.5 * 9.81 * t * t).epsilon(1e-6));
+}
+
+// ------------------------------------------------------------------ fluid box
+#include <parafsi/fluid/grid.hpp>
+#include <parafsi/model/drop_box.hpp>
+
+TEST_CASE("drop box: extents, refined block, axes and size from the scene") {
+  auto P = md::drop_scene_parameters::paper();
+  const auto R = md::drop_resolution::preset("coarse");
+  P.canopy.element_size = R.element * P.canopy.nominal_diameter;
+  const auto s = md::build_drop_scene(P);
+  md::drop_box_parameters bp;  // 5 x 5 x 7 D0, 1.5 D0 ahead
+  bp.cell = R.cell;
+  bp.growth = R.growth;
+  const md::drop_box b = md::make_drop_box(s, bp);
+  // D0 = 1 m: the numbers of the file comment, exactly.
+  const double zc = (s.positions[std::size_t(s.suspension.confluence)] - s.payload.position).z();
+  // The confluence: the riser (0.08 Ls) above the hanging point (half the payload's 0.10 m).
+  CHECK(zc == doctest::Approx(0.08 + 0.05).epsilon(1e-12));
+  CHECK(b.lo == std::array<double, 3>{-2.5, -2.5, -1.5});
+  CHECK(b.hi == std::array<double, 3>{2.5, 2.5, 5.5});
+  CHECK(b.fine_lo == std::array<double, 3>{-0.6, -0.6, zc + 0.55});
+  CHECK(b.fine_hi == std::array<double, 3>{0.6, 0.6, zc + 1.0 + 0.55});
+  CHECK(b.cell == 0.0667);
+  CHECK(b.growth == 1.2);
+  CHECK((b.axes - Eigen::Matrix3d::Identity()).norm() < 1e-15);  // vertical drop: the world axes
+  // The estimate against the grid built from these numbers: the coarse box is 38^3 =
+  // 54 872 cells (docs/validation.md §8); the estimate is within a cell per axis.
+  index_t n[3];
+  for (std::size_t d = 0; d < 3; ++d) {
+    n[d] = pf::fluid::axis::refined(b.lo[d], b.hi[d], b.fine_lo[d], b.fine_hi[d], b.cell, b.growth).cells();
+    CHECK(std::abs(b.cells_estimate[d] - double(n[d])) <= 1.0);
+  }
+  CHECK(n[0] * n[1] * n[2] == 54872);
+
+  // Fixed box: the bottom and the refined column lowered by the fall, the top unchanged.
+  bp.fall = 10.0;
+  const md::drop_box f = md::make_drop_box(s, bp);
+  CHECK(f.lo[2] == -11.5);
+  CHECK(f.fine_lo[2] == (zc + 0.55) - 10.0);
+  CHECK(f.hi[2] == b.hi[2]);
+  CHECK(f.fine_hi[2] == b.fine_hi[2]);
+  CHECK(f.fall == 10.0);
+
+  // A slanted flight path: orthonormal axes, z_b along the canopy axis, y_b = ŷ (the
+  // horizontal normal of the flight plane x–z).
+  auto Q = P;
+  Q.flight_path_angle = 30;
+  const auto sq = md::build_drop_scene(Q);
+  const md::drop_box q = md::make_drop_box(sq, md::drop_box_parameters{});
+  CHECK((q.axes.transpose() * q.axes - Eigen::Matrix3d::Identity()).norm() < 1e-14);
+  CHECK(q.axes.determinant() == doctest::Approx(1.0).epsilon(1e-14));
+  CHECK((q.axes.col(2) - sq.axis()).norm() < 1e-14);
+  CHECK((q.axes.col(1) - Eigen::Vector3d::UnitY()).norm() < 1e-14);
+}
+
+TEST_CASE("drop box and canopy: sizes that would overflow a count or the memory are refused first") {
+  const auto s = md::build_drop_scene(md::drop_scene_parameters::paper());
+  md::drop_box_parameters bp;
+  bp.cell = 1e-300;
+  CHECK_THROWS_WITH_AS(md::make_drop_box(s, bp), doctest::Contains("would have more than 1e308 cells"),
+                       pf::invalid_input);
+  bp.cell = 1e-3;  // about 1.6e9 cells
+  CHECK_THROWS_WITH_AS(md::make_drop_box(s, bp), doctest::Contains("would have about 1."), pf::invalid_input);
+  bp.cell = 0.0667;
+  bp.max_cells = 1000;
+  CHECK_THROWS_WITH_AS(md::make_drop_box(s, bp), doctest::Contains("more than the limit of 1000 cells"),
+                       pf::invalid_input);
+  bp = {};
+  bp.ahead = 8.0;  // longer than the box
+  CHECK_THROWS_WITH_AS(md::make_drop_box(s, bp), doctest::Contains("ahead of the payload"), pf::invalid_input);
+  auto P = md::drop_scene_parameters::paper();
+  P.canopy.element_size = 1e-300;
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(P), doctest::Contains("would give more than 1e308 triangles"),
+                       pf::invalid_input);
+  P.canopy.element_size = 2e-4;  // an estimate of about 8e7 triangles: under the limit of 1e8 (not built here)
+  CHECK_NOTHROW(P.canopy.validate());
+  P.canopy.max_triangles = 1e4;
+  CHECK_THROWS_WITH_AS(P.canopy.validate(), doctest::Contains("more than the limit of 10000"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::drop_resolution::preset("ultra"), doctest::Contains("unknown resolution 'ultra'"),
+                       pf::invalid_input);
 }

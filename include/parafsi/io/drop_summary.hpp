@@ -218,21 +218,29 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   return s;
 }
 
-/// One history row as CSV text: the shortest text that reads back to the same double
-/// (so a restart that re-reads the history keeps it bit-exact), NaN written as `nan`.
-inline void write_history_row(std::ostream& os, const drop_history_row& r) {
+/// Append one history row as CSV text (with its '\n') to `line`: the shortest text that
+/// reads back to the same double (so a restart that re-reads the history keeps it
+/// bit-exact), NaN written as `nan`.
+inline void append_history_row(std::string& line, const drop_history_row& r) {
   const auto v = r.values();
   char buf[40];
   for (std::size_t i = 0; i < v.size(); ++i) {
-    os << (i ? "," : "");
+    if (i) line += ',';
     if (std::isfinite(v[i])) {
       const auto res = std::to_chars(buf, buf + sizeof buf, v[i]);
-      os.write(buf, res.ptr - buf);
+      line.append(buf, std::size_t(res.ptr - buf));
     } else {
-      os << "nan";
+      line += "nan";
     }
   }
-  os << '\n';
+  line += '\n';
+}
+
+/// One history row as CSV text on a stream (`append_history_row`).
+inline void write_history_row(std::ostream& os, const drop_history_row& r) {
+  std::string line;
+  append_history_row(line, r);
+  os << line;
 }
 
 }  // namespace parafsi::io

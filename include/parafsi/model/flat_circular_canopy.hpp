@@ -47,7 +47,9 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -71,6 +73,7 @@ struct canopy_parameters {
   bool radial_bands = true;              ///< bands along the seams
   bool bands_cross_vent = true;          ///< bands join opposite seams across the vent (N even)
   int vent_band_divisions = 0;           ///< segments per half vent crossing (0: from h, >= 1)
+  double max_triangles = 1e8;            ///< largest mesh accepted (estimated before it is built)
 
   void validate() const {
     require(gores >= 3, "model::flat_circular_canopy: need at least 3 gores, got ", gores);
@@ -86,6 +89,22 @@ struct canopy_parameters {
     require(vent_band_divisions >= 0, "model::flat_circular_canopy: vent band divisions must be >= 0, got ",
             vent_band_divisions);
     require(std::isfinite(fibre_angle), "model::flat_circular_canopy: fibre angle must be finite, got ", fibre_angle);
+    // Counts from doubles, checked before any cast: rows along a seam and segments per
+    // half-gore row at the skirt bound the triangles by 2N · nr · 2 m.
+    const double Rs = skirt_corner_radius(), Rv = vent_corner_radius();
+    const double rows = radial_divisions > 0 ? double(radial_divisions) : std::max(1.0, (Rs - Rv) / element_size);
+    const double segments = std::max(1.0, Rs * std::sin(std::numbers::pi / gores) / element_size);
+    const double triangles = 4.0 * gores * rows * segments;
+    require(triangles <= max_triangles, "model::flat_circular_canopy: element size ", element_size,
+            " m would give ", float_text(triangles), " triangles, more than the limit of ", max_triangles,
+            ": use a larger element size");
+  }
+  /// An estimated count in 3 significant digits (for messages).
+  static std::string float_text(double v) {
+    if (std::isinf(v)) return std::string("more than 1e308");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "about %.3g", v);
+    return std::string(buf);
   }
   /// Corner-radius factor k_N of the diameter basis.
   double corner_factor() const {

@@ -1,0 +1,97 @@
+/// \file checked_file.hpp
+/// A text file written with every step checked: opening, each write, each flush and the
+/// close. A failure (a missing or read-only directory, a path that is a directory, a full
+/// disk, /dev/full) throws `io::write_error` naming the file and the system's reason, so a
+/// program that writes its results through it cannot report success without them.
+///
+///   io::checked_file f("out/summary.csv");     // created or truncated
+///   f.write("a,b\n1,2\n");
+///   f.close();                                  // flushes; throws if anything failed
+///
+/// Writes go through C stdio (a buffered FILE*): a write may only fail at the next flush
+/// or at close, which is why `close()` must be called; the destructor closes a file that
+/// was not closed (after an exception elsewhere) without reporting.
+/// io/ is never included by physics headers; this one needs the standard library only.
+#pragma once
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "../core/error.hpp"
+
+namespace parafsi::io {
+
+/// A file could not be written (open, write, flush or close failed).
+struct write_error : error {
+  using error::error;
+};
+
+class checked_file {
+ public:
+  /// Open `path` for writing (created, or truncated if it exists).
+  explicit checked_file(std::filesystem::path path) : path_(std::move(path)) {
+    errno = 0;
+    f_ = std::fopen(path_.c_str(), "wb");
+    if (!f_) fail("cannot open", errno);
+  }
+  checked_file(const checked_file&) = delete;
+  checked_file& operator=(const checked_file&) = delete;
+  ~checked_file() {
+    if (f_) std::fclose(f_);
+  }
+
+  const std::filesystem::path& path() const noexcept { return path_; }
+
+  void write(std::string_view s) {
+    require_open();
+    errno = 0;
+    if (!s.empty() && std::fwrite(s.data(), 1, s.size(), f_) != s.size()) fail("cannot write", errno);
+  }
+  /// Hand the buffered text to the system (so a failure shows now, not at close).
+  void flush() {
+    require_open();
+    errno = 0;
+    if (std::fflush(f_) != 0) fail("cannot write", errno);
+  }
+  /// Flush and close; the file is complete only if this returns.
+  void close() {
+    require_open();
+    errno = 0;
+    const bool flushed = std::fflush(f_) == 0;
+    const int err = errno;
+    const bool closed = std::fclose(f_) == 0;
+    f_ = nullptr;
+    if (!flushed) fail("cannot write", err);
+    if (!closed) fail("cannot close", errno);
+  }
+
+ private:
+  void require_open() const {
+    if (!f_) throw write_error("io::checked_file: '" + path_.string() + "' is already closed");
+  }
+  [[noreturn]] void fail(const char* what, int err) {
+    if (f_) {
+      std::fclose(f_);
+      f_ = nullptr;
+    }
+    std::string msg = std::string(what) + " '" + path_.string() + "'";
+    if (err != 0) msg += std::string(": ") + std::strerror(err);
+    throw write_error(msg);
+  }
+
+  std::filesystem::path path_;
+  std::FILE* f_ = nullptr;
+};
+
+/// Write `text` to `path` as one checked file (created or truncated).
+inline void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  checked_file f(path);
+  f.write(text);
+  f.close();
+}
+
+}  // namespace parafsi::io

@@ -1,0 +1,477 @@
+/// \file drop.hpp
+/// The parachute drop as library code: `run_drop(config)` builds the scene of
+/// model::drop_scene_parameters (paper() or c9()) with the config's overrides, the
+/// structure assembly (structure/from_drop_scene.hpp), the fluid box (model/drop_box.hpp)
+/// with its solver, the coupling and the explicit_stepper, runs it to `t_end` and returns
+/// the history (io::drop_history_row per output instant) and the summary; with `out` set
+/// it writes history.csv, summary.csv, the mid-plane slices, VTK files and checkpoints
+/// there. examples/parachute_drop.cpp is its command line; examples/drop_guide.cpp builds
+/// the same drop step by step from the pieces below.
+///
+/// Pieces (each usable on its own):
+///   drop_config           every choice of a run, with its default (the program's)
+///   make_drop_setup(c)    the plain data: scene parameters after the overrides, the
+///                         resolution, the scene, the fluid box, α
+///   scene/drop_steps.hpp  make_drop_grid(box), place_drop_box(fluid, box, assembly),
+///                         track_payload(stepper, dt), landing_step(dt, left): the steps
+///                         a program that builds the drop itself shares with run_drop
+///
+/// Scene: the model's values (paper: released at rest from 35 m, flight path 90°,
+/// ρ = 1.18, p = 101325, μ = 1.79e-5, g = 9.81 on the structure and payload only, payload
+/// 1.8 kg). Fluid box: model::make_drop_box (cross-section box_width × box_width D0,
+/// length box_length D0 with box_ahead D0 ahead of the payload mass centre; cells of
+/// `cell`·D0 on the block around the canopy growing by `growth` per cell outwards);
+/// frame::follow_payload translates it with the payload mass centre and turns its −z axis
+/// to the payload velocity (box = follow), or frame::fixed (box = fixed, lengthened by
+/// fixed_fall). Far field + 3-cell sponge on all six faces. HLLC-LM + MUSCL (van Leer),
+/// SSP-RK2; constant μ or inviscid (`viscosity`). Pressure-gradient scaling α (`pgs_alpha`;
+/// 0 = auto: 8 with the embedded coupling, 1 with penalty, whose spring stiffness γp/α²
+/// it would soften): the air held at p/α². Coupling: embedded (default) or penalty (PFAC,
+/// stiffening λ), both with the fabric's Ergun law.
+///
+/// Loop (each step): the stable step at `cfl`, shortened to land on the next output
+/// instant n · history_every (an integer n, so a restarted run takes the steps of the
+/// uninterrupted one); the box target (`track_payload`); the coupled step. At each output
+/// instant: a history row (checked for non-finite nodes), the αM guard (a warning once
+/// when α |v_payload| / c > 0.3), VTK and checkpoint at their intervals, the slices due.
+/// Stops with numerical_failure when the stable step collapses below 1e-9 history_every
+/// or when the payload leaves a fixed box's refined column. Restart: the stepper's state
+/// from the checkpoint (refused if its air is not at this run's ambient, i.e. another α or
+/// scene pressure, or if t_end is not after its time), the history rows up to the
+/// restored time from <out>/history.csv.
+/// Messages (progress is the caller's, through `progress`) go to stderr unless `quiet`.
+#pragma once
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <initializer_list>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../core/error.hpp"
+#include "../core/parallel.hpp"
+#include "../coupling/coupling.hpp"
+#include "../explicit_stepper.hpp"
+#include "../fluid/fluid.hpp"
+#include "../io/checkpoint.hpp"
+#include "../io/drop_history.hpp"
+#include "../io/drop_slice.hpp"
+#include "../io/drop_summary.hpp"
+#include "../io/vtk.hpp"
+#include "../model/drop_box.hpp"
+#include "../model/drop_scene.hpp"
+#include "../structure/from_drop_scene.hpp"
+#include "drop_steps.hpp"
+
+namespace parafsi::scene {
+
+/// Every choice of a drop run. The defaults are parachute_drop's (its flags bind to these
+/// fields); `out` empty writes no files.
+struct drop_config {
+  std::string canopy = "paper";      ///< paper | c9
+  std::string fabric = "mat544";     ///< paper canopy: mat544 | mat59225 | mat509
+  std::string resolution = "coarse"; ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
+  std::string coupling = "embedded"; ///< embedded | penalty
+  std::string viscosity = "auto";    ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
+  double t_end = 6.0;                ///< simulated time (s)
+  double history_every = 0.005;      ///< output interval (s)
+  double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
+  double growth = 0;                 ///< cell growth factor outside the refined block; 0 = the resolution's
+  double cfl = 0.9;                  ///< CFL number of the fluid step
+  double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
+  double membrane_damping = 0.05;    ///< membrane damping ratio of its highest mode
+  double impedance = 1.0;            ///< embedded: impedance (added-mass) stabilisation factor ζ
+  double pgs_alpha = 0.0;            ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
+  double cell = 0, element = 0;      ///< overrides of the resolution (/ D0), 0 = the resolution's
+  double initial_speed = -1;         ///< override of the scene's release speed (m/s), < 0 = scene
+  double payload_mass = -1;          ///< override of the payload mass (kg), <= 0 = scene
+  double line_stiffness = 1;         ///< multiplies EA of lines, riser and tapes (sensitivity, extremes)
+  double modulus_scale = 1;          ///< multiplies the fabric moduli E11, E22, G12
+  std::string packed = "scene";      ///< scene | reduced_radius | star_fold | constructed
+  double packed_parameter = -1;      ///< reduced_radius: s; star_fold: seam half-angle (deg); < 0 = default
+  std::string box = "follow";        ///< follow: the paper's moving box; fixed: a fixed box holding the fall
+  double fixed_fall = 0;             ///< fixed box: fall length (m) the refined column extends below the start
+  std::vector<double> slice_times{0.1, 0.2, 0.3, 0.5, 1, 2, 4, 6};  ///< mid-plane slice times (s)
+  std::string out = "out/drop";      ///< output directory; empty: no files
+  double vtk_every = 0;              ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
+  double checkpoint_every = 0;       ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
+  std::string restart;               ///< checkpoint to continue from (same scene and flags)
+  bool quiet = false;                ///< no messages on stderr
+
+  /// Throws invalid_input naming a bad field (non-finite numbers included).
+  void validate() const {
+    auto one_of = [](const std::string& v, std::initializer_list<const char*> names) {
+      for (const char* n : names)
+        if (v == n) return true;
+      return false;
+    };
+    require(one_of(canopy, {"paper", "c9"}), "parachute_drop: canopy must be paper or c9, got '", canopy, "'");
+    require(one_of(coupling, {"embedded", "penalty"}), "parachute_drop: coupling must be embedded or penalty, got '",
+            coupling, "'");
+    require(one_of(viscosity, {"auto", "constant", "inviscid"}),
+            "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
+    require(one_of(packed, {"scene", "reduced_radius", "star_fold", "constructed"}),
+            "parachute_drop: unknown packed shape '", packed, "'");
+    require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
+    const std::pair<const char*, double> numbers[] = {
+        {"t_end", t_end}, {"history_every", history_every}, {"box_width", box_width}, {"box_length", box_length},
+        {"box_ahead", box_ahead}, {"growth", growth}, {"cfl", cfl}, {"pfac", pfac}, {"stiffening", stiffening},
+        {"coupling_damping", coupling_damping}, {"membrane_damping", membrane_damping}, {"impedance", impedance},
+        {"pgs_alpha", pgs_alpha}, {"cell", cell}, {"element", element}, {"initial_speed", initial_speed},
+        {"payload_mass", payload_mass}, {"line_stiffness", line_stiffness}, {"modulus_scale", modulus_scale},
+        {"packed_parameter", packed_parameter}, {"fixed_fall", fixed_fall}, {"vtk_every", vtk_every},
+        {"checkpoint_every", checkpoint_every}};
+    for (const auto& [name, v] : numbers)
+      require(std::isfinite(v), "parachute_drop: ", name, " must be a finite number, got ", v);
+    for (double t : slice_times)
+      require(std::isfinite(t) && t >= 0, "parachute_drop: slice times must be finite and >= 0, got ", t);
+    require(t_end > 0, "parachute_drop: t_end must be > 0 s, got ", t_end);
+    require(history_every > 0, "parachute_drop: history_every must be > 0 s, got ", history_every);
+    require(t_end / history_every <= 1e9, "parachute_drop: t_end / history_every = ", t_end / history_every,
+            " output instants, more than 1e9");
+    require(cfl > 0 && cfl <= 1, "parachute_drop: cfl must be in (0, 1], got ", cfl);
+    require(growth == 0 || (growth >= 1 && growth <= 2), "parachute_drop: growth must be in [1, 2] (0: the "
+            "resolution's), got ", growth);
+    require(cell >= 0 && element >= 0, "parachute_drop: cell and element sizes must be >= 0 (0: the resolution's), "
+            "got ", cell, " and ", element);
+    require(line_stiffness > 0, "parachute_drop: line stiffness scale must be > 0, got ", line_stiffness);
+    require(modulus_scale > 0, "parachute_drop: fabric modulus scale must be > 0, got ", modulus_scale);
+    require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: PGS alpha must be >= 1 (0: auto), got ", pgs_alpha);
+    require(vtk_every >= 0 && checkpoint_every >= 0, "parachute_drop: VTK and checkpoint intervals must be >= 0 s, "
+            "got ", vtk_every, " and ", checkpoint_every);
+    require(box != "fixed" || fixed_fall > 0,
+            "parachute_drop: a fixed box needs the fall length it must hold (> 0 m), got ", fixed_fall);
+  }
+};
+
+struct drop_result {
+  std::string fabric;
+  std::vector<io::drop_history_row> history;
+  io::drop_summary summary;
+  long cells = 0, nodes = 0, triangles = 0, steps = 0;
+  double substeps_per_step = 0, wall = 0;
+  stepper_phase_times times{};
+};
+
+/// Progress of a run: called with (t, steps, done) after every step (done = false) and
+/// once at the end (done = true).
+using drop_progress = std::function<void(double t, long steps, bool done)>;
+
+/// The plain data of a run, resolved from a drop_config.
+struct drop_setup {
+  model::drop_scene_parameters params;  ///< the scene's parameters after the overrides
+  model::drop_resolution resolution;    ///< the preset after the overrides
+  model::drop_scene scene;
+  model::drop_box box;
+  double alpha = 1;                     ///< pressure-gradient scaling α (auto resolved)
+  bool fixed_box = false;               ///< frame::fixed instead of frame::follow_payload
+  bool viscous = false;                 ///< constant μ instead of inviscid
+};
+
+/// The scene, box and numbers of the config `c` (validated first).
+inline drop_setup make_drop_setup(const drop_config& c) {
+  c.validate();
+  drop_setup su;
+  model::drop_scene_parameters& P = su.params;
+  P = c.canopy == "c9" ? model::drop_scene_parameters::c9() : model::drop_scene_parameters::paper(c.fabric);
+  const double D0 = P.canopy.nominal_diameter;
+  model::drop_resolution& R = su.resolution;
+  R = model::drop_resolution::preset(c.resolution);
+  if (c.cell > 0) R.cell = c.cell;
+  if (c.growth > 0) R.growth = c.growth;
+  if (c.element > 0) R.element = c.element;
+  if (c.initial_speed >= 0) P.initial_speed = c.initial_speed;
+  if (c.payload_mass > 0) P.payload.mass = c.payload_mass;
+  for (auto* l : {&P.line, &P.skirt_tape, &P.vent_tape, &P.band}) l->stiffness_scale *= c.line_stiffness;
+  P.moduli.modulus_scale *= c.modulus_scale;
+  if (c.packed == "reduced_radius")
+    P.shape = model::packed_shape::reduced_radius(c.packed_parameter > 0 ? c.packed_parameter : 0.2);
+  else if (c.packed == "star_fold")
+    P.shape = model::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi /
+                                             180.0);
+  else if (c.packed == "constructed")
+    P.shape = model::packed_shape::constructed();
+  su.fixed_box = c.box == "fixed";
+  P.canopy.element_size = R.element * D0;
+  su.scene = model::build_drop_scene(P);
+  model::drop_box_parameters bp;
+  bp.width = c.box_width;
+  bp.length = c.box_length;
+  bp.ahead = c.box_ahead;
+  bp.cell = R.cell;
+  bp.growth = R.growth;
+  bp.fall = su.fixed_box ? c.fixed_fall : 0.0;
+  su.box = model::make_drop_box(su.scene, bp);
+  // α = 0: auto, 8 for the embedded coupling (docs/validation.md §8), 1 for penalty (its
+  // spring stiffness PFAC γp A/h would fall as 1/α²).
+  su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
+  const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
+  su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
+  return su;
+}
+
+namespace detail {
+
+/// One run of a built drop: the stepper (constructed in place: the coupling holds
+/// pointers into it), its outputs and its loop.
+template <class Fluid, class Coupling>
+class drop_run {
+ public:
+  using stepper_type = explicit_stepper<Fluid, structure::drop_assembly, Coupling>;
+
+  drop_run(const drop_config& c, const drop_setup& su, Fluid&& f, structure::drop_assembly&& a, Coupling&& cpl)
+      : c_(c),
+        su_(su),
+        s_(std::move(f), std::move(a), std::move(cpl)),
+        observe_(su.scene),
+        pgs_{su.alpha},
+        p_offset_(pgs_.pressure_offset(su.params.air_pressure)),
+        c_air_(gas::ideal{}.sound_speed(su.params.air_density, su.params.air_pressure)),
+        files_(!c.out.empty()) {}
+  drop_run(const drop_run&) = delete;
+  drop_run& operator=(const drop_run&) = delete;
+
+  drop_result run(const drop_progress& progress) {
+    drop_result res;
+    const auto& nd = s_.structure().node_set();
+    if (!c_.restart.empty()) res.history = restart();
+    open_outputs(res.history);
+    const auto& g = s_.fluid().grid();
+    res.cells = long(g.n(0)) * g.n(1) * g.n(2);
+    res.nodes = long(nd.size());
+    res.triangles = long(su_.scene.triangles.size());
+    res.fabric = std::string(su_.scene.fabric.name);
+    if (!c_.quiet)
+      std::fprintf(stderr,
+                   "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%ldx%ldx%ld, h = %.4g m near the canopy), "
+                   "%ld structure nodes, %zu triangles, coupling %s, %s box, PGS alpha %g, t_end %.3g s\n",
+                   su_.params.name.c_str(), res.fabric.c_str(), c_.resolution.c_str(), res.cells, long(g.n(0)),
+                   long(g.n(1)), long(g.n(2)), su_.box.cell, res.nodes, su_.scene.triangles.size(),
+                   c_.coupling.c_str(), c_.box.c_str(), su_.alpha, c_.t_end);
+    if (c_.restart.empty()) record(res.history);
+    write_outputs();
+    const auto t0 = std::chrono::steady_clock::now();
+    // Output times are n·history_every with an integer n (not a running sum), so a run
+    // restarted from a checkpoint picks exactly the steps of the uninterrupted run.
+    long n_out = long(std::floor(s_.time() / c_.history_every + 1e-6)) + 1;
+    double next_out = c_.history_every * double(n_out);
+    const std::vector<double>& slices = c_.slice_times;
+    std::size_t next_slice = 0;
+    while (next_slice < slices.size() && slices[next_slice] <= s_.time() + 1e-9 && !c_.restart.empty()) ++next_slice;
+    while (files_ && next_slice < slices.size() && slices[next_slice] <= 0) {
+      write_slice(0.0);
+      ++next_slice;
+    }
+    long substeps = 0;
+    while (s_.time() < c_.t_end - 1e-12) {
+      const double dt = next_step(std::min(next_out, c_.t_end));
+      track_payload(s_, dt);
+      check_fixed_box();
+      s_.step(dt);
+      substeps += s_.last_substeps();
+      if (s_.time() >= next_out - 1e-9 * c_.history_every || s_.time() >= c_.t_end - 1e-12) {
+        record(res.history);
+        write_outputs();
+        next_out = c_.history_every * double(++n_out);
+        while (files_ && next_slice < slices.size() && s_.time() >= slices[next_slice] - 1e-9)
+          write_slice(slices[next_slice++]);
+      }
+      if (progress) progress(s_.time(), s_.steps(), false);
+    }
+    if (progress) progress(s_.time(), s_.steps(), true);
+    if (hist_) hist_->close();
+    res.steps = s_.steps();
+    res.substeps_per_step = double(substeps) / double(std::max(1L, s_.steps()));
+    res.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.times = s_.timings();
+    if (!c_.quiet)
+      std::fprintf(stderr,
+                   "parachute_drop: %ld fluid steps, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
+                   "exchange %.1f, structure %.1f, fluid %.1f)\n",
+                   res.steps, res.substeps_per_step, res.wall, res.times.move_frame, res.times.exchange,
+                   res.times.structure, res.times.fluid);
+    res.summary = io::summarize(res.history, res.fabric);
+    if (files_) io::write_drop_summary(out() / "summary.csv", res.summary);
+    return res;
+  }
+
+ private:
+  std::filesystem::path out() const { return std::filesystem::path(c_.out); }
+
+  /// The stepper's state from the checkpoint; the history rows up to its time.
+  std::vector<io::drop_history_row> restart() {
+    io::load_checkpoint(c_.restart, s_);
+    // The checkpoint holds the fluid, not the far field: a run restarted with another α
+    // (or scene pressure) would put the restored air against a different ambient.
+    const double q = s_.fluid().primitive(0, 0, 0).p, q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
+    require(q > 0.5 * q_inf && q < 2.0 * q_inf, "parachute_drop: checkpoint '", c_.restart, "' holds air at ", q,
+            " Pa in a corner cell, but this run's ambient is ", q_inf, " Pa (PGS alpha ", su_.alpha,
+            "): restart with the --pgs and scene of the run that wrote it");
+    require(c_.t_end > s_.time() + 1e-12, "parachute_drop: t_end ", c_.t_end,
+            " s is not after the time of checkpoint '", c_.restart, "', ", s_.time(), " s: nothing to run");
+    std::vector<io::drop_history_row> previous;
+    if (files_) previous = io::read_drop_history(out() / "history.csv", s_.time() + 1e-12);
+    if (!c_.quiet)
+      std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows kept)\n",
+                   c_.restart.c_str(), s_.time(), previous.size());
+    return previous;
+  }
+
+  /// history.csv with the rows carried over; the VTK series.
+  void open_outputs(const std::vector<io::drop_history_row>& previous) {
+    if (!files_) return;
+    hist_.emplace(out() / "history.csv");
+    for (const auto& r : previous) hist_->append(r);
+    if (c_.vtk_every > 0) {
+      std::filesystem::create_directories(out() / "vtk");
+      pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
+    }
+    next_vtk_ = s_.time();
+    next_ckpt_ = s_.time() + c_.checkpoint_every;
+  }
+
+  /// The history row of now, the αM guard, the row to history.csv.
+  void record(std::vector<io::drop_history_row>& history) {
+    history.push_back(observe_(s_.time(), s_.structure()));
+    const io::drop_history_row& r = history.back();
+    const double alpha = su_.alpha;
+    if (alpha > 1.0 && !warned_mach_ && !c_.quiet && alpha * r.speed / c_air_ > 0.3) {
+      warned_mach_ = true;
+      std::fprintf(stderr,
+                   "\nparachute_drop: warning: at t = %.3g s the payload moves at %.3g m/s, alpha M = %.2f > 0.3 with "
+                   "PGS alpha %g: compressibility errors grow as (alpha M)^2; use --pgs %.0f or lower for this speed\n",
+                   r.t, r.speed, alpha * r.speed / c_air_, alpha, std::max(1.0, std::floor(0.2 * c_air_ / r.speed)));
+    }
+    if (hist_) hist_->write(r);
+  }
+
+  /// VTK files and the checkpoint when their instants are reached.
+  void write_outputs() {
+    if (pvd_ && s_.time() >= next_vtk_ - 1e-9 * c_.history_every) {
+      char nm[64];
+      std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
+      const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu", ff = c_.out + "/vtk/fluid_" + nm + ".vts";
+      io::write_vtu(fs, s_.structure());
+      io::vtk_options vo;
+      vo.pressure_offset = p_offset_;
+      io::write_vts(ff, s_.fluid(), vo);
+      pvd_->add(s_.time(), ff, 0);
+      pvd_->add(s_.time(), fs, 1);
+      next_vtk_ += c_.vtk_every;
+    }
+    if (files_ && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every) {
+      io::save_checkpoint(c_.out + "/checkpoint.ckpt", s_);
+      next_ckpt_ += c_.checkpoint_every;
+    }
+  }
+
+  void write_slice(double t_label) {
+    io::write_drop_slice(out(), t_label, s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
+                         structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
+  }
+
+  /// The stable step, refused when it collapses, shortened to land on `target`.
+  double next_step(double target) {
+    const double dt = s_.stable_dt(c_.cfl);
+    if (!(dt > 1e-9 * c_.history_every) || !std::isfinite(dt))
+      throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt,
+                                                      " s at t = ", s_.time(), " s (coupling ", c_.coupling,
+                                                      "); stopping"),
+                              -1, s_.time());
+    return landing_step(dt, target - s_.time());
+  }
+
+  /// Fixed box: stop with a message before the payload leaves the refined column.
+  void check_fixed_box() const {
+    if (!su_.fixed_box) return;
+    const auto& f = s_.fluid();
+    const Eigen::Vector3d xp = structure::payload(s_.structure()).body().mass_centre();
+    const Eigen::Vector3d xi = f.pose().R.transpose() * (xp - f.pose().X);
+    const double fall = su_.box.fall;
+    if (xi.z() < -fall)
+      throw numerical_failure(parafsi::detail::concat("parachute_drop: the payload has fallen ", -xi.z(),
+                                                      " m, beyond the fixed box's fall length ", fall, " m, at t = ",
+                                                      s_.time(), " s; raise --fixed-fall"),
+                              -1, s_.time());
+  }
+
+  const drop_config& c_;
+  const drop_setup& su_;
+  stepper_type s_;
+  io::drop_observer observe_;
+  fluid::pressure_gradient_scaling pgs_;
+  double p_offset_, c_air_;
+  bool files_;
+  std::optional<io::drop_history_writer> hist_;
+  std::optional<io::pvd_writer> pvd_;
+  double next_vtk_ = 0, next_ckpt_ = 0;
+  bool warned_mach_ = false;
+};
+
+/// f(viscosity, frame) for the setup's choices (resolved once: everything below is
+/// compile-time).
+template <class F>
+drop_result with_fluid_policies(const drop_setup& su, F&& f) {
+  auto with_frame = [&](auto viscosity) -> drop_result {
+    if (su.fixed_box) return f(viscosity, frame::fixed{});
+    frame::follow_payload follow;
+    follow.axis = {0.0, 0.0, -1.0};  // box −z turns to the payload velocity
+    follow.max_rate = 10.0;          // rad/s
+    return f(viscosity, follow);
+  };
+  if (!su.viscous) return with_frame(viscosity::inviscid{});
+  viscosity::constant visc;
+  visc.mu_value = su.params.air_viscosity;
+  return with_frame(visc);
+}
+
+}  // namespace detail
+
+/// Run the drop of `c` (rules in the file comment); `progress` is told every step.
+inline drop_result run_drop(const drop_config& c, const drop_progress& progress = {}) {
+  const drop_setup su = make_drop_setup(c);
+  const model::drop_scene& S = su.scene;
+  const model::drop_scene_parameters& P = su.params;
+  if (!c.out.empty()) std::filesystem::create_directories(c.out);
+  const fluid::rectilinear_grid grid = make_drop_grid(su.box);
+  // Pressure-gradient scaling: the air is held at p∞/α² (sound speed c/α); outputs show
+  // physical pressures p∞ + (q − p∞/α²).
+  const fluid::pressure_gradient_scaling pgs{su.alpha};
+  pgs.validate();
+  const fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};
+  auto bc = boundary::set::all(boundary::far_field{air.rho, air.u, air.p});
+  bc.layer = {3, 0.5};
+  return detail::with_fluid_policies(su, [&](auto visc, auto frame) -> drop_result {
+    structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
+    fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, frame};
+    fl.initialize([&](const Eigen::Vector3d&) { return air; });
+    place_drop_box(fl, su.box, chute);
+    if (parallel::max_threads() > 1) fl.set_threading(true);
+    const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
+    auto go = [&](auto cpl) -> drop_result {
+      detail::drop_run<decltype(fl), decltype(cpl)> run{c, su, std::move(fl), std::move(chute), std::move(cpl)};
+      return run.run(progress);
+    };
+    if (c.coupling == "embedded") {
+      coupling::embedded_options eo;
+      eo.impedance = c.impedance;
+      return go(coupling::embedded{law, eo});
+    }
+    coupling::penalty_options po;
+    po.pfac = c.pfac;
+    po.stiffening = c.stiffening;
+    po.damping_ratio = c.coupling_damping;
+    return go(coupling::penalty{law, po});
+  });
+}
+
+}  // namespace parafsi::scene

@@ -22,12 +22,12 @@
 namespace parafsi::model {
 
 struct duct_screen_scene {
-  std::array<index_t, 3> cells;   ///< fluid cells along x, y, z: (cells, 2, 2)
-  std::array<double, 3> lo, hi;   ///< duct corners (0, 0, 0) and (L, W, W) (m)
-  double length = 0;              ///< L (m)
-  double width = 0;               ///< W = 2 L / cells (m)
-  double x_sheet = 0;             ///< x_s (m)
-  rect_triangulation sheet;       ///< the sheet across the duct at x = x_s
+  std::array<index_t, 3> cells;  ///< fluid cells along x, y, z: (cells, 2, 2)
+  std::array<double, 3> lo, hi;  ///< duct corners (0, 0, 0) and (L, W, W) (m)
+  double length = 0;             ///< L (m)
+  double width = 0;              ///< W = 2 L / cells (m)
+  double x_sheet = 0;            ///< x_s (m)
+  rect_triangulation sheet;      ///< the sheet across the duct at x = x_s
 
   double area() const { return width * width; }  ///< cross-section = sheet area (m²)
 };

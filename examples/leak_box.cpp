@@ -8,7 +8,7 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
-#include <parafsi/model/rect_mesh.hpp>
+#include <parafsi/model/duct_screen.hpp>
 
 namespace pf = parafsi;
 namespace st = pf::structure;
@@ -40,18 +40,18 @@ int main(int argc, char** argv) {
   examples::apply_threads(co);
   return examples::guarded("leak_box", [&]() -> int {
     return examples::dispatch(co.flux, co.limiter, [&](auto flux, auto recon) -> int {
-      const double L = 1.0, xs = 0.5, W = 2.0 * L / cells, rho = 1.18, p0 = 101325.0;
-      auto grid = pf::fluid::rectilinear_grid::uniform({cells, 2, 2}, {0, 0, 0}, {L, W, W});
+      const auto d = pf::model::duct_screen(1.0, cells, 0.5);  // 1 m box, membrane at 0.5 m
+      const double xs = d.x_sheet, rho = 1.18, p0 = 101325.0;
+      auto grid = pf::fluid::rectilinear_grid::uniform(d.cells, d.lo, d.hi);
       pf::fluid::solver fl{grid, pf::boundary::set::all(pf::boundary::slip_wall{}), flux, recon};
       fl.initialize([&](const Eigen::Vector3d& xi) {
         return pf::fluid::prim<double>{rho, {0, 0, 0}, xi.x() < xs ? p0 + 0.5 * DP : p0 - 0.5 * DP};
       });
-      const auto m = pf::model::rect_mesh({xs, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
       st::nodes nd;
-      for (const auto& x : m.positions) nd.add(x);
+      for (const auto& x : d.sheet.positions) nd.add(x);
       for (pf::index_t i = 0; i < nd.size(); ++i) nd.pin(i);
       st::triangle_mesh tm;
-      tm.triangles = m.triangles;
+      tm.triangles = d.sheet.triangles;
       st::membrane_tri mem{tm, st::material::fabric<>::isotropic(3e8, 0.3, 0.054, 1.1e-4)};
       st::assembly as{std::move(nd), std::move(mem)};
       as.integrator().gravity = {0, 0, 0};
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
       auto run = [&](auto cpl) -> int {
       pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
       const auto& g = s.fluid().grid();
-      const double area = W * W;
+      const double area = d.area();
       auto halves = [&](double& ml, double& mr, double& pl, double& pr) {
         ml = mr = pl = pr = 0;
         int nl = 0, nr = 0;

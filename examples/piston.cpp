@@ -12,7 +12,7 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
-#include <parafsi/model/rect_mesh.hpp>
+#include <parafsi/model/duct_screen.hpp>
 
 namespace pf = parafsi;
 namespace st = pf::structure;
@@ -42,19 +42,19 @@ int main(int argc, char** argv) {
   examples::apply_threads(co);
   return examples::guarded("piston", [&]() -> int {
     return examples::dispatch(co.flux, co.limiter, [&](auto flux, auto recon) -> int {
-      const double L = 2.0, x0 = 0.5, W = 2.0 * L / cells;  // cross-section two cells wide
-      auto grid = pf::fluid::rectilinear_grid::uniform({cells, 2, 2}, {0, 0, 0}, {L, W, W});
+      const auto d = pf::model::duct_screen(2.0, cells, 0.5);  // 2 m duct, plate at 0.5 m
+      const double x0 = d.x_sheet;
+      auto grid = pf::fluid::rectilinear_grid::uniform(d.cells, d.lo, d.hi);
       pf::boundary::set bc = pf::boundary::set::all(pf::boundary::slip_wall{});
       bc.axis(0, pf::boundary::far_field{});
       pf::fluid::solver fl{grid, bc, flux, recon};
       const double rho = 1.18, p0 = 101325.0;
       fl.fill_uniform({rho, {0, 0, 0}, p0});
-      const auto m = pf::model::rect_mesh({x0, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
       st::nodes nd;
-      for (const auto& x : m.positions) nd.add(x);
+      for (const auto& x : d.sheet.positions) nd.add(x);
       for (pf::index_t i = 0; i < nd.size(); ++i) nd.prescribe_velocity(i, {v, 0, 0});
       st::triangle_mesh tm;
-      tm.triangles = m.triangles;
+      tm.triangles = d.sheet.triangles;
       st::membrane_tri mem{tm, st::material::fabric<>::isotropic(1e6, 0.3, 1.0, 1e-3)};
       st::assembly as{std::move(nd), std::move(mem)};
       as.integrator().gravity = {0, 0, 0};

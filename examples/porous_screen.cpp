@@ -10,7 +10,7 @@
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
 #include <parafsi/model/fabric_catalogue.hpp>
-#include <parafsi/model/rect_mesh.hpp>
+#include <parafsi/model/duct_screen.hpp>
 
 #include <filesystem>
 
@@ -44,20 +44,20 @@ int main(int argc, char** argv) {
     return examples::dispatch(co.flux, co.limiter, [&](auto flux, auto recon) -> int {
       const auto& fab = pf::model::fabric(fabric);
       const pf::porosity::ergun law{fab.alpha, fab.beta, fab.thickness};
-      const double L = 1.0, xs = 0.5, W = 2.0 * L / cells, rho = 1.18, p0 = 101325.0;
-      auto grid = pf::fluid::rectilinear_grid::uniform({cells, 2, 2}, {0, 0, 0}, {L, W, W});
+      const auto d = pf::model::duct_screen(1.0, cells, 0.5);  // 1 m duct, sheet at 0.5 m
+      const double xs = d.x_sheet, rho = 1.18, p0 = 101325.0;
+      auto grid = pf::fluid::rectilinear_grid::uniform(d.cells, d.lo, d.hi);
       pf::boundary::set bc = pf::boundary::set::all(pf::boundary::slip_wall{});
       bc.side(0, 0, pf::boundary::inflow{rho, {V, 0, 0}, p0});
       bc.side(0, 1, pf::boundary::outflow{true, p0});
       pf::fluid::solver fl{grid, bc, flux, recon};
       fl.fill_uniform({rho, {V, 0, 0}, p0});
       // Sheet: 2 x 2 quads, edges pinned, the centre node free.
-      const auto m = pf::model::rect_mesh({xs, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
       st::nodes nd;
-      for (const auto& x : m.positions) nd.add(x);
-      for (auto i : m.edge) nd.pin(i);
+      for (const auto& x : d.sheet.positions) nd.add(x);
+      for (auto i : d.sheet.edge) nd.pin(i);
       st::triangle_mesh tm;
-      tm.triangles = m.triangles;
+      tm.triangles = d.sheet.triangles;
       const double E = fab.break_strength / 0.05 / fab.elongation / fab.thickness;  // secant modulus
       st::membrane_tri mem{tm, st::material::fabric<>::isotropic(E, 0.3, fab.areal_density, fab.thickness),
                            st::membrane_options{0.1}};

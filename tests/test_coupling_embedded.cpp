@@ -1,7 +1,6 @@
 // Embedded (membrane-aware face flux) coupling: the membrane Riemann problem, the
-// impulse balance (air momentum change = − structure momentum change, every step,
-// to round-off), the travel rejection, stiff and extreme porosities, and two
-// membrane layers in one fluid cell.
+// travel rejection, stiff and extreme porosities, and two membrane layers in one fluid
+// cell. (Its impulse balance is in test_coupling_impulse, typed over both couplings.)
 #include <doctest/doctest.h>
 
 #include <parafsi/coupling/coupling.hpp>
@@ -9,74 +8,16 @@
 #include <parafsi/fluid/exact_riemann.hpp>
 #include <parafsi/fluid/fluid.hpp>
 #include <parafsi/model/fabric_catalogue.hpp>
-#include <parafsi/model/rect_mesh.hpp>
 #include <parafsi/structure/structure.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <string>
 
+#include "coupling_test_util.hpp"
+
 namespace pf = parafsi;
 namespace st = pf::structure;
-
-namespace {
-template <class Porosity>
-auto make_stepper(Porosity por, double areal_density, double E, Eigen::Vector3d v0 = {4.0, 1.0, -0.5}) {
-  auto grid = pf::fluid::rectilinear_grid::uniform({8, 8, 8}, {0, 0, 0}, {0.4, 0.4, 0.4});
-  pf::fluid::solver fl{grid, pf::boundary::set::all(pf::boundary::periodic{})};
-  fl.fill_uniform({1.2, {0, 0, 0}, 101325.0});
-  // A tilted square patch moving obliquely through still air.
-  const auto m = pf::model::rect_mesh({0.12, 0.1, 0.11}, {0.02, 0.18, 0.0}, {0.0, 0.03, 0.17}, 3, 3);
-  st::nodes nd;
-  for (const auto& x : m.positions) nd.add(x, v0);
-  st::triangle_mesh tm;
-  tm.triangles = m.triangles;
-  st::membrane_tri mem{tm, st::material::fabric<>::isotropic(E, 0.3, areal_density, 1e-4)};
-  st::assembly as{std::move(nd), std::move(mem)};
-  as.integrator().gravity = {0, 0, 0};
-  return pf::explicit_stepper{std::move(fl), std::move(as), pf::coupling::embedded{por}};
-}
-
-template <class S>
-void check_balance(S& s, int steps, const char* label) {
-  auto fm = [&] {
-    const auto t = s.fluid().totals();
-    return Eigen::Vector3d(t.momentum[0], t.momentum[1], t.momentum[2]);
-  };
-  double worst = 0, worst_s = 0, scale = 0;
-  pf::index_t faces = 0;
-  for (int n = 0; n < steps; ++n) {
-    const Eigen::Vector3d pf0 = fm(), ps0 = s.structure().linear_momentum();
-    s.step(s.stable_dt(0.5));
-    const Eigen::Vector3d dpf = fm() - pf0, dps = s.structure().linear_momentum() - ps0;
-    const auto& d = s.coupling().diagnostics();
-    faces = std::max(faces, d.faces);
-    scale = std::max(scale, d.impulse_structure.norm());
-    worst_s = std::max(worst_s, (dps - d.impulse_structure).norm() / std::max(d.impulse_structure.norm(), 1e-300));
-    worst = std::max(worst, (dpf + dps).norm() / std::max(d.impulse_structure.norm(), 1e-300));
-  }
-  std::printf("%s: %d steps, up to %ld patched faces, max step impulse %.3e N s, "
-              "max |dP_fluid + dP_structure| / |J| = %.2e, max |dP_structure - J| / |J| = %.2e\n",
-              label, steps, long(faces), scale, worst, worst_s);
-  CHECK(faces > 10);
-  CHECK(scale > 0);
-  CHECK(worst < 1e-9);
-  CHECK(worst_s < 1e-12);
-}
-}  // namespace
-
-TEST_CASE("embedded: impulse balance to round-off every step (impermeable, moving membrane)") {
-  pf::parallel::set_threads(1);
-  auto s = make_stepper(pf::porosity::impermeable{}, 0.5, 1e5);
-  check_balance(s, 40, "embedded impermeable");
-}
-
-TEST_CASE("embedded: impulse balance with structure substeps and a porous fabric") {
-  const auto& f = pf::model::fabric_catalogue[2];
-  auto s = make_stepper(pf::porosity::ergun{f.alpha, f.beta, f.thickness}, 0.05, 5e10);
-  check_balance(s, 40, "embedded ergun mat509, stiff membrane");
-  CHECK(s.last_substeps() > 1);
-}
 
 TEST_CASE("embedded: the membrane Riemann problem (wall, series layers, transparent limit)") {
   using emb_d = pf::coupling::embedded<pf::porosity::darcy>;
@@ -115,7 +56,7 @@ TEST_CASE("embedded: the membrane Riemann problem (wall, series layers, transpar
 
 TEST_CASE("embedded: a membrane moving faster than a cell per step is rejected with a message") {
   pf::parallel::set_threads(1);
-  auto s = make_stepper(pf::porosity::impermeable{}, 0.5, 1e5, {1000.0, 0.0, 0.0});
+  auto s = ctu::tilted_patch(pf::coupling::embedded{pf::porosity::impermeable{}}, 1.2, 0.5, 1e5, {1000.0, 0.0, 0.0});
   CHECK(s.stable_dt(0.5) < 0.5 * 0.05 / 1000.0 + 1e-12);  // stable_dt honours the travel limit
   std::string msg;
   try {
@@ -135,17 +76,15 @@ namespace {
 /// given x positions.
 template <class Porosity>
 auto layered_box(Porosity por, std::vector<double> xs) {
-  const int n = 16;
-  const double W = 2.0 / n;
-  auto grid = pf::fluid::rectilinear_grid::uniform({n, 2, 2}, {0, 0, 0}, {1.0, W, W});
-  pf::fluid::solver fl{grid, pf::boundary::set::all(pf::boundary::slip_wall{})};
+  pf::fluid::solver fl{ctu::duct_grid(pf::model::duct_screen(1.0, 16, xs.front())),
+                      pf::boundary::set::all(pf::boundary::slip_wall{})};
   fl.initialize([&](const Eigen::Vector3d& xi) {
     return pf::fluid::prim<double>{1.2, {0, 0, 0}, xi.x() < 0.5 ? 101350.0 : 101300.0};
   });
   st::nodes nd;
   st::triangle_mesh tm;
   for (double x : xs) {
-    const auto m = pf::model::rect_mesh({x, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
+    const auto m = pf::model::duct_screen(1.0, 16, x).sheet;
     const pf::index_t off = nd.size();
     for (const auto& p : m.positions) nd.add(p);
     for (auto i : m.edge) nd.pin(off + i);

@@ -20,14 +20,10 @@
 //   which is why the heavy plate's results are identical with and without it.
 #include <doctest/doctest.h>
 
-#include <parafsi/coupling/coupling.hpp>
-#include <parafsi/explicit_stepper.hpp>
-#include <parafsi/fluid/fluid.hpp>
-#include <parafsi/model/rect_mesh.hpp>
-#include <parafsi/structure/structure.hpp>
-
 #include <cmath>
 #include <cstdio>
+
+#include "coupling_test_util.hpp"
 
 namespace pf = parafsi;
 namespace st = pf::structure;
@@ -36,19 +32,15 @@ namespace {
 constexpr double rho0 = 1.18, p0 = 101325.0, v0 = 0.1, x0 = 1.0;
 
 auto make_plate(double areal_mass, int cells, double impedance) {
-  const double L = 2.0, W = 2.0 * L / cells;
-  auto grid = pf::fluid::rectilinear_grid::uniform({cells, 2, 2}, {0, 0, 0}, {L, W, W});
+  const auto d = pf::model::duct_screen(2.0, cells, x0);
   pf::boundary::set bc = pf::boundary::set::all(pf::boundary::slip_wall{});
   bc.axis(0, pf::boundary::far_field{});
-  pf::fluid::solver fl{grid, bc};
+  pf::fluid::solver fl{ctu::duct_grid(d), bc};
   fl.fill_uniform({rho0, {0, 0, 0}, p0});
-  const auto m = pf::model::rect_mesh({x0, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
   st::nodes nd;
-  for (const auto& x : m.positions) nd.add(x, {v0, 0, 0});
-  st::triangle_mesh tm;
-  tm.triangles = m.triangles;
+  for (const auto& x : d.sheet.positions) nd.add(x, {v0, 0, 0});
   // Stiff in-plane (a rigid plate moving as a whole), areal mass as given.
-  st::membrane_tri mem{tm, st::material::fabric<>::isotropic(1e9, 0.3, areal_mass, 1e-3)};
+  st::membrane_tri mem{ctu::sheet_mesh(d), st::material::fabric<>::isotropic(1e9, 0.3, areal_mass, 1e-3)};
   st::assembly as{std::move(nd), std::move(mem)};
   as.integrator().gravity.setZero();
   pf::coupling::embedded_options eo;

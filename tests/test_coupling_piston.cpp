@@ -1,24 +1,24 @@
-// Penalty-coupled piston (methods §4.9.1) and stiff / extreme coupling cases:
-// - a rigid plate driven at v into still air: the compressed air obeys the acoustic
-//   relation Δp = ρ c u_air within 2 %; against the plate speed, Δp = ρ c v is missed by
-//   the numerical leak of the zero-thickness penalty wall (reported, asserted < 8 %);
+// Piston (methods §4.9.1), the pressure rise typed over the coupling list, and stiff /
+// extreme penalty cases; the plate is the sheet of model/duct_screen.hpp (2 m duct, plate
+// at 0.5 m, nodes driven at v):
+// - penalty: a rigid plate driven at v into still air: the compressed air obeys the
+//   acoustic relation Δp = ρ c u_air within 2 %; against the plate speed, Δp = ρ c v is
+//   missed by the numerical leak of the zero-thickness penalty wall (reported, asserted
+//   < 10 % at PFAC ≥ 1);
+// - embedded (the plate a moving wall in the face fluxes): Δp within 2 % of ρ c v and
+//   within 0.5 % of the exact piston shock, at 50 to 200 cells and 2 to 20 m/s, with the
+//   air moving at the plate speed (no leak);
 // - PFAC far above the fluid-side cap (capped automatically) and ten times below the
-//   cap run stably; substeps m = 1 and m = 10 agree;
-// - a membrane moving more than a cell per fluid step is rejected with a message;
-// - the embedded coupling (the plate a moving wall in the face fluxes): Δp within 2 %
-//   of ρ c v and within 0.5 % of the exact piston shock, at 50 to 200 cells and 2 to
-//   20 m/s, with the air moving at the plate speed (no leak).
+//   cap run stably; a free fabric-weight plate stays stable;
+// - a membrane moving more than a cell per fluid step is rejected with a message.
 #include <doctest/doctest.h>
-
-#include <parafsi/coupling/coupling.hpp>
-#include <parafsi/explicit_stepper.hpp>
-#include <parafsi/fluid/fluid.hpp>
-#include <parafsi/model/rect_mesh.hpp>
-#include <parafsi/structure/structure.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
+
+#include "coupling_test_util.hpp"
 
 namespace pf = parafsi;
 namespace st = pf::structure;
@@ -35,20 +35,16 @@ double exact_piston_rise(double v) {
 template <class MakeCoupling>
 auto make_piston_with(double v, int cells, MakeCoupling make_coupling, double areal_density = 1.0,
                       bool free_plate = false) {
-  const double L = 2.0, x0 = 0.5, W = 2.0 * L / cells;
-  auto grid = pf::fluid::rectilinear_grid::uniform({cells, 2, 2}, {0, 0, 0}, {L, W, W});
+  const auto d = pf::model::duct_screen(2.0, cells, 0.5);
   pf::boundary::set bc = pf::boundary::set::all(pf::boundary::slip_wall{});
   bc.axis(0, pf::boundary::far_field{});
-  pf::fluid::solver fl{grid, bc};
+  pf::fluid::solver fl{ctu::duct_grid(d), bc};
   fl.fill_uniform({rho0, {0, 0, 0}, p0});
-  const auto m = pf::model::rect_mesh({x0, 0, 0}, {0, W, 0}, {0, 0, W}, 2, 2);
   st::nodes nd;
-  for (const auto& x : m.positions) nd.add(x, {v, 0, 0});
+  for (const auto& x : d.sheet.positions) nd.add(x, {v, 0, 0});
   if (!free_plate)
     for (pf::index_t i = 0; i < nd.size(); ++i) nd.prescribe_velocity(i, {v, 0, 0});
-  st::triangle_mesh tm;
-  tm.triangles = m.triangles;
-  st::membrane_tri mem{tm, st::material::fabric<>::isotropic(1e6, 0.3, areal_density, 1e-3)};
+  st::membrane_tri mem{ctu::sheet_mesh(d), st::material::fabric<>::isotropic(1e6, 0.3, areal_density, 1e-3)};
   st::assembly as{std::move(nd), std::move(mem)};
   as.integrator().gravity = {0, 0, 0};
   return pf::explicit_stepper{std::move(fl), std::move(as), make_coupling()};
@@ -101,40 +97,59 @@ piston_result run_piston(S& s, double v, double t_end, double x0 = 0.5) {
   r.u_air /= n;
   return r;
 }
-}  // namespace
+/// The pressure-rise runs per coupling and what each asserts.
+template <class C>
+struct piston;
 
-TEST_CASE("piston: pressure rise against rho c v") {
-  pf::parallel::set_threads(1);  // tiny grids: threads only add overhead
-  const double v = 2.0, c = std::sqrt(1.4 * p0 / rho0);
-  for (double pfac : {0.1, 1.0, 10.0}) {
-    auto s = make_piston(v, pfac, 100);
-    const auto r = run_piston(s, v, 3e-3);
-    const double e_air = r.rise / (rho0 * c * r.u_air) - 1.0, e_v = r.rise / (rho0 * c * v) - 1.0;
+template <>
+struct piston<ctu::penalty> {
+  struct run {
+    double v, pfac;
+    int cells;
+  };
+  static inline const std::vector<run> runs{{2.0, 0.1, 100}, {2.0, 1.0, 100}, {2.0, 10.0, 100}};
+  static void check(const run& c, const piston_result& r) {
+    const double cs = std::sqrt(1.4 * p0 / rho0);
+    const double e_air = r.rise / (rho0 * cs * r.u_air) - 1.0, e_v = r.rise / (rho0 * cs * c.v) - 1.0;
     std::printf("piston PFAC %-4g: dp = %.2f Pa, rho c v = %.2f Pa (error %+.2f %%), u_air = %.4f m/s "
                 "(leak %.4f m/s), dp / (rho c u_air) - 1 = %+.2f %%, max |d|/h = %.4f\n",
-                pfac, r.rise, rho0 * c * v, 100 * e_v, r.u_air, v - r.u_air, 100 * e_air, r.max_pen);
+                c.pfac, r.rise, rho0 * cs * c.v, 100 * e_v, r.u_air, c.v - r.u_air, 100 * e_air, r.max_pen);
     CHECK(std::fabs(e_air) < 0.02);  // acoustic relation in the compressed air
     // The penalty leak through the zero-thickness plate (docs/coupling.md): with the
     // default HLLC-LM (acoustic floor, K = 2) −6.7 % at PFAC 1 and −9.2 % at PFAC 10.
-    if (pfac >= 1.0) CHECK(std::fabs(e_v) < 0.10);
+    if (c.pfac >= 1.0) CHECK(std::fabs(e_v) < 0.10);
   }
-}
+};
 
-TEST_CASE("embedded piston: pressure rise within 2 % of rho c v (0.5 % of the exact piston shock), no leak") {
-  pf::parallel::set_threads(1);
-  const double c = std::sqrt(1.4 * p0 / rho0);
-  for (auto [v, cells] : {std::pair{2.0, 50}, std::pair{2.0, 100}, std::pair{2.0, 200}, std::pair{20.0, 100}}) {
-    auto s = make_piston_with(v, cells, [] { return pf::coupling::embedded{pf::porosity::impermeable{}}; });
-    const auto r = run_piston(s, v, 3e-3);
-    const double e_v = r.rise / (rho0 * c * v) - 1.0, e_exact = r.rise / exact_piston_rise(v) - 1.0;
+template <>
+struct piston<ctu::embedded> {
+  struct run {
+    double v, pfac;
+    int cells;
+  };
+  static inline const std::vector<run> runs{{2.0, 0, 50}, {2.0, 0, 100}, {2.0, 0, 200}, {20.0, 0, 100}};
+  /// Within 2 % of ρcv (0.5 % of the exact piston shock), the air moving with the plate (no leak).
+  static void check(const run& c, const piston_result& r) {
+    const double cs = std::sqrt(1.4 * p0 / rho0);
+    const double e_v = r.rise / (rho0 * cs * c.v) - 1.0, e_exact = r.rise / exact_piston_rise(c.v) - 1.0;
     std::printf("embedded piston v %-4g cells %-3d: dp = %.2f Pa, rho c v = %.2f Pa (%+.3f %%), exact shock %.2f Pa "
                 "(%+.3f %%), u_air = %.5f m/s\n",
-                v, cells, r.rise, rho0 * c * v, 100 * e_v, exact_piston_rise(v), 100 * e_exact, r.u_air);
+                c.v, c.cells, r.rise, rho0 * cs * c.v, 100 * e_v, exact_piston_rise(c.v), 100 * e_exact, r.u_air);
     CHECK(std::fabs(e_exact) < 0.005);
-    if (v <= 2.0) CHECK(std::fabs(e_v) < 0.02);  // the bound (the shock adds 0.35 % at 2 m/s)
-    CHECK(std::fabs(r.u_air - v) < 1e-3 * v);  // the air moves with the plate: no leak
+    if (c.v <= 2.0) CHECK(std::fabs(e_v) < 0.02);  // the bound (the shock adds 0.35 % at 2 m/s)
+    CHECK(std::fabs(r.u_air - c.v) < 1e-3 * c.v);  // the air moves with the plate: no leak
+  }
+};
+}  // namespace
+
+TEST_CASE_TEMPLATE_DEFINE("piston: pressure rise against rho c v", C, rise) {
+  pf::parallel::set_threads(1);  // tiny grids: threads only add overhead
+  for (const auto& c : piston<C>::runs) {
+    auto s = make_piston_with(c.v, c.cells, [&] { return C::make(pf::porosity::impermeable{}, c.pfac); });
+    piston<C>::check(c, run_piston(s, c.v, 3e-3));
   }
 }
+TEST_CASE_TEMPLATE_APPLY(rise, ctu::couplings);
 
 TEST_CASE("stiff cases: PFAC far above the fluid-side cap, and ten times below it") {
   const double v = 2.0;

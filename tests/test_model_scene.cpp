@@ -1,11 +1,15 @@
-// Drop-scene builders: packed shapes, lines, riser, payload, masses, the C-9 variant, rejection.
+// Drop-scene builders: packed shapes, lines, riser, payload, masses, the C-9 variant, rejection;
+// the duct/screen scene of the coupling tests.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
 
 #include <parafsi/model/drop_scene.hpp>
+#include <parafsi/model/duct_screen.hpp>
 
 namespace pf = parafsi;
 namespace md = parafsi::model;
@@ -317,4 +321,46 @@ TEST_CASE("drop box and canopy: sizes that would overflow a count or the memory 
   CHECK_THROWS_WITH_AS(P.canopy.validate(), doctest::Contains("more than the limit of 10000"), pf::invalid_input);
   CHECK_THROWS_WITH_AS(md::drop_resolution::preset("ultra"), doctest::Contains("unknown resolution 'ultra'"),
                        pf::invalid_input);
+}
+
+TEST_CASE("duct screen: cubic cells, the sheet spans the cross-section at x_s with normal +x; bad input rejected") {
+  const auto d = md::duct_screen(2.0, 100, 0.5);
+  CHECK(d.cells == std::array<index_t, 3>{100, 2, 2});
+  CHECK(d.width == 0.04);  // 2 L / cells: two cells of 2 cm across
+  CHECK(d.hi[0] == 2.0);
+  CHECK(d.hi[1] == d.width);
+  CHECK(d.hi[2] == d.width);
+  CHECK(d.hi[0] / d.cells[0] == doctest::Approx(d.hi[1] / d.cells[1]).epsilon(1e-15));  // cubic cells
+  REQUIRE(d.sheet.positions.size() == 9);
+  REQUIRE(d.sheet.triangles.size() == 8);
+  CHECK(d.sheet.edge.size() == 8);
+  double area = 0;
+  for (const auto& t : d.sheet.triangles) {
+    const Eigen::Vector3d a = d.sheet.positions[std::size_t(t[0])], b = d.sheet.positions[std::size_t(t[1])],
+                          c = d.sheet.positions[std::size_t(t[2])];
+    const Eigen::Vector3d n = 0.5 * (b - a).cross(c - a);
+    CHECK(n.x() > 0);  // counter-clockwise about +x
+    CHECK(std::abs(n.y()) + std::abs(n.z()) == 0.0);
+    area += n.norm();
+  }
+  CHECK(area == doctest::Approx(d.area()).epsilon(1e-14));
+  CHECK(d.area() == doctest::Approx(0.04 * 0.04).epsilon(1e-15));
+  for (const auto& x : d.sheet.positions) {
+    CHECK(x.x() == 0.5);
+    CHECK(x.y() >= 0.0);
+    CHECK(x.y() <= d.width);
+    CHECK(x.z() >= 0.0);
+    CHECK(x.z() <= d.width);
+  }
+  CHECK(d.sheet.positions[4].isApprox(Eigen::Vector3d(0.5, 0.02, 0.02)));  // the free centre node
+  std::string msg;
+  try {
+    md::duct_screen(1.0, 40, 1.5);
+  } catch (const pf::invalid_input& e) {
+    msg = e.what();
+  }
+  CHECK(msg.find("model::duct_screen") != std::string::npos);
+  CHECK(msg.find("1.5") != std::string::npos);
+  CHECK_THROWS_AS(md::duct_screen(1.0, 1, 0.5), pf::invalid_input);
+  CHECK_THROWS_AS(md::duct_screen(-1.0, 40, 0.5), pf::invalid_input);
 }

@@ -12,33 +12,9 @@
 #include <parafsi/structure/reference/hencky.hpp>
 #include <parafsi/structure/relax.hpp>
 
-namespace st = parafsi::structure;
+#include "membrane_rig.hpp"
 
-namespace {
-double centre_deflection(int rings, double a, double h, double E, double nu, double p) {
-  const auto d = parafsi::model::disk_mesh(a, rings);
-  st::nodes nd;
-  for (const auto& x : d.positions) nd.add(x);
-  for (auto i : d.rim) nd.pin(i);
-  st::triangle_mesh m;
-  m.triangles = d.triangles;
-  st::membrane_tri mem{m, st::material::fabric<>::isotropic(E, nu, 1000 * h, h)};
-  mem.set_pressure(p);
-  st::assembly s{std::move(nd), std::move(mem)};
-  s.integrator().gravity.setZero();
-  const auto ref = st::reference::hencky(nu);
-  const double sigma = ref.s0 * std::cbrt(E * p * p * a * a / (8 * h * h));
-  const double omega1 = 2.405 * std::sqrt(sigma / 1000.0) / a;
-  s.integrator().mass_damping = 2 * omega1;
-  st::relax_options ro;
-  ro.tolerance = 1e-14;
-  ro.t_min = 6.3 / omega1;
-  ro.t_max = 400 / omega1;
-  const auto r = st::relax(s, ro);
-  REQUIRE(r.converged);
-  return s.node_set().position(0).z();
-}
-}  // namespace
+namespace st = parafsi::structure;
 
 TEST_CASE("Hencky reference solver reproduces the published constants") {
   // Timoshenko & Woinowsky-Krieger (§96) quote Hencky's series for ν = 0.25:
@@ -57,12 +33,12 @@ TEST_CASE("clamped circular membrane: centre deflection within 3 % of Hencky, se
   // A few thousand elements: one thread (a parallel region per phase costs more than the
   // work on a loaded 2-core runner; results are thread-count independent anyway).
   parafsi::parallel::set_threads(1);
-  const double a = 0.5, h = 1e-4, E = 1e9, nu = 0.3, p = 40.0;  // pa/(Eh) = 2e-4, w0/a ≈ 0.038
-  const double w_ref = st::reference::hencky(nu).coefficient * a * std::cbrt(p * a / (E * h));
+  const mrig::hencky_case hc;  // a = 0.5 m, h = 0.1 mm, E = 1 GPa, ν = 0.3, p = 40 Pa: pa/(Eh) = 2e-4, w0/a ≈ 0.038
+  const double w_ref = hc.w_ref();
   const int rings[] = {5, 10, 20};
   double w[3];
   for (int k = 0; k < 3; ++k) {
-    w[k] = centre_deflection(rings[k], a, h, E, nu, p);
+    w[k] = hc.tri_deflection(rings[k]);
     std::printf("Hencky: N = %2d (%4d triangles)  w0 = %.8e m  error %+.3e\n", rings[k], 6 * rings[k] * rings[k],
                 w[k], w[k] / w_ref - 1);
   }

@@ -22,68 +22,14 @@
 #include <parafsi/structure/reference/hencky.hpp>
 #include <parafsi/structure/relax.hpp>
 
+#include "membrane_rig.hpp"
+
 namespace st = parafsi::structure;
 using parafsi::index_t;
-
-namespace {
-
-/// Unit square, n×n quads, interior nodes perturbed by up to `jitter` cells.
-st::quad_mesh square_quads(int n, std::vector<Eigen::Vector3d>& X, double jitter, double zjitter = 0.0,
-                           unsigned seed = 7) {
-  std::mt19937 g(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  X.clear();
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      Eigen::Vector3d p{double(i) / n, double(j) / n, 0.0};
-      if (i > 0 && i < n && j > 0 && j < n) p += Eigen::Vector3d{jitter * u(g), jitter * u(g), 0.0} / n;
-      p.z() += zjitter * u(g) / n;
-      X.push_back(p);
-    }
-  st::quad_mesh m;
-  auto id = [&](int i, int j) { return index_t(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) m.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-  return m;
-}
-
-Eigen::Matrix3d rotation(double a, double b, double c) {
-  return (Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(b, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(c, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
-/// A stand-alone quad membrane on a node set (no assembly), forces evaluated directly.
-template <class Fabric>
-struct rig {
-  st::nodes nd;
-  st::membrane_quad<Fabric> mem;
-  rig(const std::vector<Eigen::Vector3d>& X, st::quad_mesh m, Fabric f, st::quad_options o = {})
-      : mem(std::move(m), f, o) {
-    for (const auto& x : X) nd.add(x);
-    nd.materialize();
-    nd.reset_masses();
-    mem.finalize(nd);
-    nd.finalize_masses();
-  }
-  void place(const std::vector<Eigen::Vector3d>& x) {
-    for (std::size_t i = 0; i < x.size(); ++i) nd.set_position(index_t(i), x[i]);
-  }
-  template <bool Vectorize = true>
-  std::vector<Eigen::Vector3d> forces() {
-    auto& s = nd.data();
-    for (index_t i = 0; i < nd.size(); ++i) s.get<st::field::fx>()[i] = s.get<st::field::fy>()[i] = s.get<st::field::fz>()[i] = 0;
-    mem.template compute_forces<false, Vectorize>(nd.kinematics());
-    mem.template scatter<false>(nd);
-    std::vector<Eigen::Vector3d> f;
-    for (index_t i = 0; i < nd.size(); ++i) f.push_back(nd.force(i));
-    return f;
-  }
-};
-
+using mrig::rig;
+using mrig::rotation;
+using mrig::square_quads;
 using elastic = st::material::fabric<st::wrinkling::none>;
-
-}  // namespace
 
 TEST_CASE("membrane_quad patch test: a uniform strain is reproduced exactly on a distorted mesh") {
   std::vector<Eigen::Vector3d> X;
@@ -91,36 +37,22 @@ TEST_CASE("membrane_quad patch test: a uniform strain is reproduced exactly on a
   const double warp_angle = 0.5236;  // 30°
   mesh.warp = {std::cos(warp_angle), std::sin(warp_angle), 0.0};
   rig r(X, mesh, elastic{2e9, 1e9, 0.3, 0.4e9, 0.1, 1e-4}, st::quad_options{0.0, 0.05, 0.1, 0.0});
-  Eigen::Matrix3d F0 = Eigen::Matrix3d::Identity();
-  F0(0, 0) = 1.02; F0(0, 1) = 0.013; F0(1, 0) = 0.004; F0(1, 1) = 0.985;
-  const Eigen::Matrix3d R = rotation(0.7, -0.4, 1.1);
-  std::vector<Eigen::Vector3d> x;
-  for (const auto& p : X) x.push_back(R * (F0 * p) + Eigen::Vector3d{0.3, -2.0, 5.0});
-  r.place(x);
-  const Eigen::Matrix3d Eg = 0.5 * (F0.transpose() * F0 - Eigen::Matrix3d::Identity());
-  const Eigen::Vector3d e1{std::cos(warp_angle), std::sin(warp_angle), 0}, e2{-std::sin(warp_angle), std::cos(warp_angle), 0};
-  const double E11 = e1.dot(Eg * e1), E22 = e2.dot(Eg * e2), E12x2 = 2 * e1.dot(Eg * e2);
+  const mrig::patch_map map(warp_angle);
+  r.place(map(X));
   double err = 0, hg = 0;
   for (index_t e = 0; e < r.mem.size(); ++e) {
-    const auto ss = r.mem.strain_stress(r.nd, e);
-    err = std::max({err, std::abs(ss[0] - E11), std::abs(ss[1] - E22), std::abs(ss[2] - E12x2)});
+    err = std::max(err, map.strain_error(r.mem.strain_stress(r.nd, e)));
     hg = std::max(hg, r.mem.hourglass_mode(r.nd, e).norm());
   }
   std::printf("quad patch test: max strain error %.3e (strain ~ %.3e), max hourglass displacement %.3e m\n", err,
-              std::abs(E11), hg);
+              std::abs(map.E11), hg);
   CHECK(err < 1e-13);
   CHECK(hg < 1e-14);
-  const auto f = r.forces();
-  double fmax = 0, finterior = 0;
-  for (int j = 0; j <= 6; ++j)
-    for (int i = 0; i <= 6; ++i) {
-      const double m = f[std::size_t(j * 7 + i)].norm();
-      fmax = std::max(fmax, m);
-      if (i > 0 && i < 6 && j > 0 && j < 6) finterior = std::max(finterior, m);
-    }
-  std::printf("quad patch test: max interior residual %.3e of max boundary force %.3e\n", finterior, fmax);
-  CHECK(fmax > 1.0);
-  CHECK(finterior < 1e-10 * fmax);
+  const auto res = mrig::square_residual(r.forces(), 6);
+  std::printf("quad patch test: max interior residual %.3e of max boundary force %.3e\n", res.max_interior,
+              res.max_force);
+  CHECK(res.max_force > 1.0);
+  CHECK(res.max_interior < 1e-10 * res.max_force);
 }
 
 TEST_CASE("membrane_quad objectivity: a rigid rotation creates no strain and no force (flat and warped reference)") {
@@ -132,15 +64,10 @@ TEST_CASE("membrane_quad objectivity: a rigid rotation creates no strain and no 
     std::vector<Eigen::Vector3d> x;
     for (const auto& p : X) x.push_back(R * p + Eigen::Vector3d{1, 2, 3});
     r.place(x);
-    double smax = 0, hg = 0;
-    for (index_t e = 0; e < r.mem.size(); ++e) {
-      const auto ss = r.mem.strain_stress(r.nd, e);
-      for (int k = 0; k < 6; ++k) smax = std::max(smax, std::abs(ss[std::size_t(k)]) / (k < 3 ? 1.0 : 1e9));
-      hg = std::max(hg, r.mem.hourglass_mode(r.nd, e).norm());
-    }
-    const auto f = r.forces();
-    double fmax = 0;
-    for (const auto& v : f) fmax = std::max(fmax, v.norm());
+    const double smax = mrig::max_strain_stress(r);
+    double hg = 0;
+    for (index_t e = 0; e < r.mem.size(); ++e) hg = std::max(hg, r.mem.hourglass_mode(r.nd, e).norm());
+    const double fmax = mrig::max_norm(r.forces());
     std::printf("quad rigid rotation (reference warp %.2f cell): max |E| %.3e, hourglass %.3e m, max |f| %.3e N\n", zj,
                 smax, hg, fmax);
     CHECK(smax < 1e-14);
@@ -352,30 +279,13 @@ TEST_CASE("membrane_quad: SIMD and scalar kernels agree; results do not depend o
   st::quad_mesh m;
   m.quads = d.quads;
   std::mt19937 g(11);
-  std::uniform_real_distribution<double> u(-0.01, 0.01);
-  std::vector<Eigen::Vector3d> x;
-  for (const auto& p : d.positions) x.push_back(1.01 * p + Eigen::Vector3d{u(g), u(g), u(g)});
+  const auto x = mrig::stretched_noisy(d.positions, g);
   rig r(d.positions, m, st::material::fabric<>{2e9, 1e9, 0.3, 0.3e9, 0.05, 1e-4}, st::quad_options{0.05, 0.05, 0.1, 0.1});
   r.mem.set_pressure(100.0);
   r.place(x);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
   for (std::size_t i = 0; i < x.size(); ++i) r.nd.set_velocity(index_t(i), Eigen::Vector3d{u(g), u(g), u(g)} * 100.0);
-  const auto fv = r.forces<true>();
-  const auto fs = r.forces<false>();
-  double diff = 0, scale = 0;
-  for (std::size_t i = 0; i < fv.size(); ++i) { diff = std::max(diff, (fv[i] - fs[i]).norm()); scale = std::max(scale, fs[i].norm()); }
-  std::printf("quad SIMD (width %zu) vs scalar: max diff %.3e of %.3e\n", parafsi::simd::width, diff, scale);
-  CHECK(scale > 0);
-  CHECK(diff <= 1e-12 * scale);
-  if (parafsi::parallel::enabled()) {
-    parafsi::parallel::set_threads(1);
-    const auto f1 = r.forces<true>();
-    parafsi::parallel::set_threads(2);
-    const auto f2 = r.forces<true>();
-    bool same = true;
-    for (std::size_t i = 0; i < f1.size(); ++i) same = same && f1[i] == f2[i];
-    CHECK(same);
-    parafsi::parallel::set_threads(1);
-  }
+  mrig::check_simd_and_threads(r, "quad ");
 }
 
 TEST_CASE("membrane_quad: energy ledger balances for an undamped pressurised sheet") {
@@ -405,46 +315,11 @@ TEST_CASE("membrane_quad: energy ledger balances for an undamped pressurised she
   CHECK(std::abs(E.balance()) < 0.01 * wmax);
 }
 
-namespace {
-struct hencky_case {
-  double a = 0.5, h = 1e-4, E = 1e9, nu = 0.3, p = 40.0;
-  double w_ref() const { return st::reference::hencky(nu).coefficient * a * std::cbrt(p * a / (E * h)); }
-  double omega1() const {
-    const double sigma = st::reference::hencky(nu).s0 * std::cbrt(E * p * p * a * a / (8 * h * h));
-    return 2.405 * std::sqrt(sigma / 1000.0) / a;
-  }
-  template <class Asm>
-  void relax(Asm& s) const {
-    s.integrator().gravity.setZero();
-    s.integrator().mass_damping = 2 * omega1();
-    st::relax_options ro;
-    ro.tolerance = 1e-14;
-    ro.t_min = 6.3 / omega1();
-    ro.t_max = 400 / omega1();
-    REQUIRE(st::relax(s, ro).converged);
-  }
-  auto fabric() const { return st::material::fabric<>::isotropic(E, nu, 1000 * h, h); }
-};
-}  // namespace
-
 TEST_CASE("clamped circular membrane: quad and triangle agree with each other and with Föppl–Hencky") {
   parafsi::parallel::set_threads(1);
-  const hencky_case hc;
+  const mrig::hencky_case hc;
   // Triangles: 6 N² CST, N = 16 (1536 elements, 817 nodes).
-  double w_tri;
-  {
-    const auto d = parafsi::model::disk_mesh(hc.a, 16);
-    st::nodes nd;
-    for (const auto& x : d.positions) nd.add(x);
-    for (auto i : d.rim) nd.pin(i);
-    st::triangle_mesh m;
-    m.triangles = d.triangles;
-    st::membrane_tri mem{m, hc.fabric()};
-    mem.set_pressure(hc.p);
-    st::assembly s{std::move(nd), std::move(mem)};
-    hc.relax(s);
-    w_tri = s.node_set().position(0).z();
-  }
+  const double w_tri = hc.tri_deflection(16);
   // Quads: O-grid, n = 20 (400 + 80·10 = 1200 elements, 1241 nodes).
   auto quad_run = [&](int n, double r_hg, double& hg_share) {
     const auto d = parafsi::model::disk_quad_mesh(hc.a, n);
@@ -491,38 +366,15 @@ TEST_CASE("membrane_quad folded start: reference far from the initial positions 
   st::quad_mesh m;
   m.quads = d.quads;
   m.reference = d.positions;
-  st::nodes nd;
-  for (const auto& p : d.positions) {
-    const double r = std::hypot(p.x(), p.y()), th = std::atan2(p.y(), p.x());
-    nd.add({0.3 * p.x(), 0.3 * p.y(), 0.02 * std::sin(8 * th) * r});
-  }
-  for (auto i : d.rim) nd.pin(i);
+  auto nd = mrig::folded_disk(d.positions, d.rim);
   using fab = st::material::fabric<st::wrinkling::tension_field>;
   st::assembly s{std::move(nd), st::membrane_quad{m, fab::isotropic(4e8, 0.2, 0.05, 1e-4)}};
-  s.part<0>().set_pressure(200.0);
-  s.integrator().gravity.setZero();
-  s.integrator().mass_damping = 30.0;
-  s.track_energy();
-  const double U0 = s.evaluate_forces();
-  const double H0 = s.part<0>().hourglass_energy();
-  long m_sub = 0;
-  while (s.time() < 0.3) m_sub = std::max(m_sub, s.advance(1e-3));
-  double emax = 0, emin = 0;
-  for (index_t e = 0; e < s.part<0>().size(); ++e) {
-    const auto ss = s.part<0>().strain_stress(s.node_set(), e);
-    emax = std::max({emax, ss[0], ss[1]});
-    emin = std::min({emin, ss[0], ss[1]});
-  }
-  const double apex = s.node_set().position(d.centre).z();
+  double H0 = 0;
+  const auto r = mrig::run_folded(s, d.centre, [&](auto& a) { H0 = a.template part<0>().hourglass_energy(); });
   const auto& E = s.energy();
-  const double input = U0 + E.external;
   std::printf("quad folded start: U0 %.3e J (hourglass %.3e J), apex %.3f m, max substeps/ms %ld, strain [%.3e, %.3e], "
-              "K %.3e U %.3e (hourglass %.3e) D %.3e W %.3e, balance error %.3e of input %.3e\n", U0, H0, apex, m_sub,
-              emin, emax, E.kinetic, E.strain, s.part<0>().hourglass_energy(), E.damping, E.external,
-              E.balance() - U0, input);
-  CHECK(apex > 0.2);
-  CHECK(emax < 0.02);
-  CHECK(emin < -0.1);
-  CHECK(E.kinetic < 1e-3 * input);
-  CHECK(std::abs(E.balance() - U0) < 0.05 * input);
+              "K %.3e U %.3e (hourglass %.3e) D %.3e W %.3e, balance error %.3e of input %.3e\n", r.U0, H0, r.apex,
+              r.max_substeps, r.emin, r.emax, E.kinetic, E.strain, s.part<0>().hourglass_energy(), E.damping,
+              E.external, E.balance() - r.U0, r.U0 + E.external);
+  mrig::check_folded(r, E);
 }

@@ -10,6 +10,9 @@ endfunction()
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/lib -DPARAFSI_BUILD_TESTS=OFF
     -DPARAFSI_BUILD_EXAMPLES=OFF -DPARAFSI_BUILD_BENCH=OFF -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} --install ${WORK_DIR}/lib)
+if(NOT EXISTS ${WORK_DIR}/prefix/share/doc/parafsi/LICENSE)
+  message(FATAL_ERROR "the install did not put the licence in share/doc/parafsi")
+endif()
 run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/app -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
     -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/app)

@@ -271,10 +271,21 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
       touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
       spread_ready_ = true;
     }
+    if (opt_.impedance > 0) apply_nodes<true>(sink, nd, dt_kick);
+    else apply_nodes<false>(sink, nd, dt_kick);
+  }
+
+  template <class Fluid>
+  void finish(Fluid&, double) {}
+
+ private:
+  /// The substep's nodal forces; the impedance term chosen once per call.
+  template <bool Impedance>
+  void apply_nodes(structure::load_sink& sink, const structure::nodes& nd, double dt_kick) {
     const double inv = 1.0 / total_kick_;
     for (index_t i : touched_) {
       Eigen::Vector3d F = node_J_[std::size_t(i)] * inv;
-      if (opt_.impedance > 0) {
+      if constexpr (Impedance) {
         const Eigen::Vector3d Fz = -(node_C_[std::size_t(i)] * (nd.velocity(i) - node_v0_[std::size_t(i)]));
         F += Fz;
         diag_.impulse_impedance += Fz * dt_kick;
@@ -285,8 +296,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     }
   }
 
-  template <class Fluid>
-  void finish(Fluid&, double) {}
+ public:
 
   // ------------------------------------------------------------- face physics
   /// Pressure and density behind the wave a piston makes in the state (ρ, p, c) when it

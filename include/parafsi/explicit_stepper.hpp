@@ -2,15 +2,19 @@
 /// `explicit_stepper<Fluid, Structure, Coupling>`: one step of the coupled system as a
 /// short recipe of named, timed phases (DESIGN §4, methods §8.3):
 ///
-///   1. move_frame  — plan the box motion over the step (the frame policy's plan on a
-///                    copy of the pose; the fluid step applies the same plan);
+///   1. move_frame  — the frame target (frame_target.hpp: e.g. follow_body, the payload's
+///                    predicted mass centre) sets the tracking frame's target, then the box
+///                    motion over the step is planned once and handed to the coupling
+///                    (penalty: the pose at each substep) and to the fluid step;
 ///   2. exchange    — snapshot the fluid at tⁿ (velocity, ρ, K = γp), coupling stiffness
 ///                    and its caps, travel check, clear the fluid's source arrays;
 ///   3. structure   — m = ceil(Δt_f / Δt_s,crit) equal substeps, Δt_s,crit = min(assembly
 ///                    limit, coupling-spring limit); coupling forces enter each substep
 ///                    through the assembly's load hook, their reactions are accumulated
 ///                    as fluid impulses;
-///   4. fluid       — impulses → sources (J, W)/(Δt_f V_cell), one fluid step;
+///   4. fluid       — impulses → sources (J, W)/(Δt_f V_cell), one fluid step with the
+///                    planned motion (and the coupling as face patcher when it is one,
+///                    fluid/patch.hpp);
 ///   (a `fluid_first` coupling — coupling::embedded — runs 4 before 3: its loads are
 ///   the face fluxes of the fluid step, applied to the structure substeps after it);
 ///   5. time        — t += Δt_f.
@@ -21,8 +25,11 @@
 ///   explicit_stepper s{std::move(solver), no_structure{}}; // fluid only
 /// Momentum: what the structure gains, the air loses (same kick lengths on both sides),
 /// to round-off, every step (tests/test_coupling_impulse.cpp).
-/// Frame tracking (follow_payload) is the user's: call fluid().frame().track(...)
-/// before step() (the drop scene does it from the payload state).
+/// Frame tracking: give a frame target as the fourth argument,
+///   explicit_stepper s{std::move(solver), std::move(assembly), coupling, follow_body{body_of<6>, 9.81}};
+/// or call fluid().frame().track(...) yourself before step() (no_frame_target, the default).
+/// No heap allocation happens inside step() after the first step (fluid, structure and
+/// couplings keep their scratch; tests/test_no_allocation.cpp).
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -33,6 +40,9 @@
 
 #include "core/error.hpp"
 #include "coupling/none.hpp"
+#include "fluid/frame/pose.hpp"
+#include "fluid/patch.hpp"
+#include "frame_target.hpp"
 #include "structure/assembly.hpp"
 #include "structure/central_difference.hpp"
 
@@ -48,7 +58,7 @@ struct stepper_phase_times {
   double total() const { return move_frame + exchange + structure + fluid; }
 };
 
-template <class Fluid, class Structure, class Coupling = coupling::none>
+template <class Fluid, class Structure, class Coupling = coupling::none, class FrameTarget = no_frame_target>
 class explicit_stepper {
  public:
   static constexpr bool has_fluid = !std::is_same_v<Fluid, no_fluid>;
@@ -64,9 +74,14 @@ class explicit_stepper {
   static_assert(!coupled || (has_fluid && has_structure),
                 "explicit_stepper: a coupling needs both a fluid and a structure; use coupling::none with "
                 "no_fluid or no_structure");
+  static constexpr bool has_frame_target = FrameTarget::active;
+  static_assert(!has_frame_target || (has_fluid && has_structure),
+                "explicit_stepper: a frame target follows a structure part with the fluid box; give both");
+  /// The coupling replaces face fluxes in the fluid step (coupling::embedded).
+  static constexpr bool patches_faces = coupled && fluid::face_patcher<Coupling>;
 
-  explicit_stepper(Fluid f, Structure s, Coupling c = {})
-      : fluid_(std::move(f)), structure_(std::move(s)), coupling_(std::move(c)) {
+  explicit_stepper(Fluid f, Structure s, Coupling c = {}, FrameTarget target = {})
+      : fluid_(std::move(f)), structure_(std::move(s)), coupling_(std::move(c)), target_(std::move(target)) {
     if constexpr (has_structure) {
       if (structure_.node_set().needs_finalize()) structure_.finalize();
       prev_substep_ = structure_.steps() == 0 ? 0.0 : -1.0;
@@ -85,6 +100,8 @@ class explicit_stepper {
   Structure& structure() noexcept requires has_structure { return structure_; }
   const Coupling& coupling() const noexcept { return coupling_; }
   Coupling& coupling() noexcept { return coupling_; }
+  const FrameTarget& frame_target() const noexcept { return target_; }
+  FrameTarget& frame_target() noexcept { return target_; }
   /// Structure substeps of the last step.
   long last_substeps() const noexcept { return last_m_; }
   /// Length of the last structure substep (0 before the first step): the next step's
@@ -132,10 +149,13 @@ class explicit_stepper {
 
   void step(double dt) {
     require(dt > 0 && std::isfinite(dt), "explicit_stepper::step: dt must be > 0 and finite, got ", dt);
-    if constexpr (coupled) {
-      timed(times_.move_frame, [&] { coupling_.plan(fluid_, dt); });
-      timed(times_.exchange, [&] { coupling_.exchange(fluid_, structure_, dt); });
-    }
+    if constexpr (has_fluid)
+      timed(times_.move_frame, [&] {
+        if constexpr (has_frame_target) target_(fluid_, structure_, dt);
+        motion_ = fluid_.plan_motion(dt);
+        if constexpr (coupled) coupling_.plan(fluid_, motion_);
+      });
+    if constexpr (coupled) timed(times_.exchange, [&] { coupling_.exchange(fluid_, structure_, dt); });
     auto structure_phase = [&] {
       if constexpr (has_structure) {
         timed(times_.structure, [&] {
@@ -169,7 +189,8 @@ class explicit_stepper {
       if constexpr (has_fluid) {
         timed(times_.fluid, [&] {
           if constexpr (coupled) coupling_.finish(fluid_, dt);
-          fluid_.step(dt);
+          if constexpr (patches_faces) fluid_.step(dt, motion_, coupling_);
+          else fluid_.step(dt, motion_);
         });
       }
     };
@@ -195,6 +216,8 @@ class explicit_stepper {
   [[no_unique_address]] Fluid fluid_;
   [[no_unique_address]] Structure structure_;
   [[no_unique_address]] Coupling coupling_;
+  [[no_unique_address]] FrameTarget target_;
+  frame::motion motion_{};  ///< the box motion of the current step (move_frame phase)
   double t_ = 0;
   double prev_substep_ = 0;
   long steps_ = 0;
@@ -206,5 +229,7 @@ template <class F, class S>
 explicit_stepper(F, S) -> explicit_stepper<F, S, coupling::none>;
 template <class F, class S, class C>
 explicit_stepper(F, S, C) -> explicit_stepper<F, S, C>;
+template <class F, class S, class C, class T>
+explicit_stepper(F, S, C, T) -> explicit_stepper<F, S, C, T>;
 
 }  // namespace parafsi

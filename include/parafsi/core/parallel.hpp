@@ -28,6 +28,15 @@ inline void set_threads([[maybe_unused]] int n) noexcept {
 #endif
 }
 
+/// Index of the calling thread in the current parallel region (0 outside one).
+inline int thread_id() noexcept {
+#if defined(_OPENMP)
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
 /// True when compiled with OpenMP.
 inline constexpr bool enabled() noexcept {
 #if defined(_OPENMP)
@@ -50,15 +59,23 @@ inline void for_range(index_t begin, index_t end, F&& f, bool threaded = true) {
 #endif
 }
 
-/// Deterministic reduction: each index contributes f(i) to a per-index slot and the
-/// slots are combined in index order, so the result does not depend on threads.
+/// Deterministic reduction: each index contributes f(i) to a per-index slot of
+/// `slots` (resized to end − begin; no allocation once large enough) and the slots are
+/// combined in index order, so the result does not depend on threads.
+template <class T, class F, class Op>
+inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op, bool threaded, std::vector<T>& slots) {
+  const std::size_t n = static_cast<std::size_t>(end > begin ? end - begin : 0);
+  slots.resize(n);
+  for_range(begin, end, [&](index_t i) { slots[static_cast<std::size_t>(i - begin)] = f(i); }, threaded);
+  T acc = init;
+  for (std::size_t i = 0; i < n; ++i) acc = op(acc, slots[i]);
+  return acc;
+}
+/// As above with slots of its own (allocates).
 template <class T, class F, class Op>
 inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op, bool threaded = true) {
-  std::vector<T> part(static_cast<std::size_t>(end > begin ? end - begin : 0), init);
-  for_range(begin, end, [&](index_t i) { part[static_cast<std::size_t>(i - begin)] = f(i); }, threaded);
-  T acc = init;
-  for (const T& p : part) acc = op(acc, p);
-  return acc;
+  std::vector<T> slots;
+  return reduce(begin, end, init, std::forward<F>(f), std::forward<Op>(op), threaded, slots);
 }
 
 }  // namespace parafsi::parallel

@@ -58,6 +58,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -65,9 +66,12 @@
 #include <Eigen/Core>
 
 #include "../core/error.hpp"
+#include "../fluid/patch.hpp"
 #include "../fluid/solver.hpp"
+#include "../fluid/view.hpp"
 #include "../structure/assembly.hpp"
 #include "../structure/nodes.hpp"
+#include "detail/membrane_coupling.hpp"
 #include "kinds.hpp"
 #include "porosity/impermeable.hpp"
 
@@ -110,27 +114,18 @@ struct embedded_diagnostics {
 };
 
 template <class Porosity = porosity::impermeable>
-class embedded {
+class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, embedded_options> {
+  using base = detail::membrane_coupling<embedded<Porosity>, Porosity, embedded_options>;
+  using base::attached_;
+  using base::opt_;
+  using base::por_;
+
  public:
-  using policy_kind = kind::coupling;
-  using porosity_type = Porosity;
-  static constexpr bool active = true;
   /// The fluid step runs before the structure substeps (the loads come from its fluxes).
   static constexpr bool fluid_first = true;
   static constexpr const char* name() noexcept { return "embedded"; }
+  using base::base;
 
-  embedded() { opt_.validate(); }
-  explicit embedded(Porosity por, embedded_options opt = {}) : por_(por), opt_(opt) {
-    por_.validate();
-    opt_.validate();
-  }
-
-  /// Couple only these triangles (default: every membrane_tri part of the assembly).
-  embedded& couple(std::vector<std::array<index_t, 3>> triangles) {
-    user_tris_ = std::move(triangles);
-    have_user_tris_ = true;
-    return *this;
-  }
   /// Mark elements (indices into the coupled triangles) as open: vents, slots. They
   /// do not block the air and carry no load.
   embedded& open(std::vector<index_t> elements) {
@@ -138,9 +133,6 @@ class embedded {
     return *this;
   }
 
-  const Porosity& porosity() const noexcept { return por_; }
-  const embedded_options& options() const noexcept { return opt_; }
-  embedded_options& options() noexcept { return opt_; }
   const embedded_diagnostics& diagnostics() const noexcept { return diag_; }
   const std::vector<std::array<index_t, 3>>& triangles() const noexcept { return tris_; }
   bool blocking(index_t e) const { return !open_[std::size_t(e)]; }
@@ -164,15 +156,14 @@ class embedded {
 
   // ------------------------------------------------------------- stepper hooks
   template <class Fluid, class Asm>
-  void attach(Fluid& f, Asm& s) {
-    auto& nd = s.node_set();
-    if (nd.needs_finalize()) s.finalize();
-    tris_ = user_tris_;
-    if (!have_user_tris_) collect_triangles(s, tris_, std::make_index_sequence<Asm::part_count>{});
-    for (std::size_t e = 0; e < tris_.size(); ++e)
-      for (int a = 0; a < 3; ++a)
-        require(tris_[e][std::size_t(a)] >= 0 && tris_[e][std::size_t(a)] < nd.size(), "coupling::embedded: triangle ",
-                e, " names node ", tris_[e][std::size_t(a)], " outside [0, ", nd.size(), ")");
+  void attach(Fluid&, Asm& s) {
+    tris_ = this->attach_triangles(s);
+    const auto& nd = s.node_set();
+    // Stage weights β_s = Π_{r ≥ s} b_r (Shu–Osher form of the fluid's RK scheme).
+    using Time = typename Fluid::time_type;
+    beta_.assign(std::size_t(Time::stages), 1.0);
+    for (int st = 0; st < Time::stages; ++st)
+      for (int r = st; r < Time::stages; ++r) beta_[std::size_t(st)] *= Time::b[std::size_t(r)];
     open_.assign(tris_.size(), 0);
     for (index_t e : open_list_) {
       require(e >= 0 && std::size_t(e) < tris_.size(), "coupling::embedded: open element ", e, " outside [0, ",
@@ -181,18 +172,19 @@ class embedded {
     }
     diag_.through_flow.assign(tris_.size(), 0.0);
     node_J_.assign(std::size_t(nd.size()), Eigen::Vector3d::Zero());
-    (void)f;
     attached_ = true;
   }
 
+  /// The faces are found at the pose of tⁿ; the planned motion is not needed.
   template <class Fluid>
-  void plan(const Fluid&, double) {}
+  void plan(const Fluid&, const frame::motion&) {}
 
   /// Find the crossed faces at the structure positions of tⁿ (box pose of tⁿ), check
-  /// the membrane's travel, and install the face handler for the coming fluid step.
+  /// the membrane's travel, and list the faces this coupling patches in the coming
+  /// fluid step (the stepper hands the coupling to the step as its face patcher).
   template <class Fluid, class Asm>
   void exchange(Fluid& f, const Asm& s, double dt_f) {
-    require(attached_, "coupling::embedded: not attached (use it through explicit_stepper)");
+    this->require_attached();
     const auto& g = f.grid();
     const auto& nd = s.node_set();
     const frame::pose& pose = f.pose();
@@ -210,7 +202,7 @@ class embedded {
         const double travel = vr.norm() * dt_f / h;
         if (travel > opt_.max_cells_per_step)
           throw numerical_failure(
-              detail::concat("coupling::embedded: membrane element ", e, " (node ", t[std::size_t(a)], ") moves ",
+              parafsi::detail::concat("coupling::embedded: membrane element ", e, " (node ", t[std::size_t(a)], ") moves ",
                              vr.norm(), " m/s relative to the fluid grid, ", travel, " cells of size ", h,
                              " m in one fluid step of ", dt_f, " s (limit ", opt_.max_cells_per_step,
                              " cell per step); the membrane would jump over cell centres: reduce the time step "
@@ -219,12 +211,6 @@ class embedded {
       }
     }
     find_faces(g, nd, pose);
-    // Stage weights β_s = Π_{r ≥ s} b_r (Shu–Osher form of the fluid's RK scheme).
-    using Time = typename Fluid::time_type;
-    beta_.assign(std::size_t(Time::stages), 1.0);
-    for (int st = 0; st < Time::stages; ++st)
-      for (int r = st; r < Time::stages; ++r) beta_[std::size_t(st)] *= Time::b[std::size_t(r)];
-    calls_ = 0;
     face_J_.assign(faces_.size(), Eigen::Vector3d::Zero());
     std::fill(diag_.through_flow.begin(), diag_.through_flow.end(), 0.0);
     diag_.impulse_structure.setZero();
@@ -232,19 +218,19 @@ class embedded {
     diag_.work_fluid = diag_.work_structure = diag_.mass_defect = 0;
     diag_.max_through_velocity = 0;
     spread_ready_ = false;
-    {
-      const auto& U = f.conserved_storage();
-      Uf_ = {U.template get<fluid::field::rho>(), U.template get<fluid::field::mx>(),
-             U.template get<fluid::field::my>(), U.template get<fluid::field::mz>(), U.template get<fluid::field::E>()};
-    }
-    if (opt_.impedance > 0) impedance_setup(g, nd, pose);
-    std::vector<std::pair<index_t, int>> list;
-    list.reserve(faces_.size());
-    for (const auto& fr : faces_) list.push_back({fr.high, fr.axis});
-    if (list.empty()) f.set_face_patches({}, {});
-    else
-      f.set_face_patches(std::move(list), [this](const fluid::face_context& fc, fluid::cons<double>& lo,
-                                                 fluid::cons<double>& hi) { this->face_flux(fc, lo, hi); });
+    if (opt_.impedance > 0) impedance_setup(f.view(), nd);
+    patch_list_.clear();
+    for (const auto& fr : faces_) patch_list_.push_back({fr.high, fr.axis});
+  }
+
+  // ------------------------------------------------------------- face patcher
+  /// The faces found by the last exchange (fluid::face_patcher).
+  std::span<const fluid::patch_face> patch_faces() const noexcept { return patch_list_; }
+
+  /// The membrane flux of one patched face at one RK stage (fluid::face_patcher); the
+  /// cell states are the stage's, read through the fluid's view.
+  void patch(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo, fluid::cons<double>& hi) {
+    face_flux(fc, v, lo, hi);
   }
 
   /// No coupling springs; with the impedance term, its explicit substep limit
@@ -294,10 +280,21 @@ class embedded {
       touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
       spread_ready_ = true;
     }
+    if (opt_.impedance > 0) apply_nodes<true>(sink, nd, dt_kick);
+    else apply_nodes<false>(sink, nd, dt_kick);
+  }
+
+  template <class Fluid>
+  void finish(Fluid&, double) {}
+
+ private:
+  /// The substep's nodal forces; the impedance term chosen once per call.
+  template <bool Impedance>
+  void apply_nodes(structure::load_sink& sink, const structure::nodes& nd, double dt_kick) {
     const double inv = 1.0 / total_kick_;
     for (index_t i : touched_) {
       Eigen::Vector3d F = node_J_[std::size_t(i)] * inv;
-      if (opt_.impedance > 0) {
+      if constexpr (Impedance) {
         const Eigen::Vector3d Fz = -(node_C_[std::size_t(i)] * (nd.velocity(i) - node_v0_[std::size_t(i)]));
         F += Fz;
         diag_.impulse_impedance += Fz * dt_kick;
@@ -308,8 +305,7 @@ class embedded {
     }
   }
 
-  template <class Fluid>
-  void finish(Fluid&, double) {}
+ public:
 
   // ------------------------------------------------------------- face physics
   /// Pressure and density behind the wave a piston makes in the state (ρ, p, c) when it
@@ -412,6 +408,11 @@ class embedded {
     index_t first;  ///< first crossing in crossings_
     int n;          ///< layers
   };
+  struct raw_crossing {
+    index_t high;
+    int axis;
+    crossing c;
+  };
 
   static double local_h(const fluid::rectilinear_grid& g, const Eigen::Vector3d& xi) {
     double h = std::numeric_limits<double>::infinity();
@@ -431,20 +432,19 @@ class embedded {
 
   /// Impedance matrices C_i = ζ Σ_faces (ρ_L c_L + ρ_R c_R) A (λ_a / k) n nᵀ of the nodes
   /// of crossed elements (cell states of tⁿ), their velocities vⁿ and the substep limit.
-  void impedance_setup(const fluid::rectilinear_grid& g, const structure::nodes& nd, const frame::pose& pose) {
+  void impedance_setup(const fluid::view& fv, const structure::nodes& nd) {
+    const fluid::rectilinear_grid& g = *fv.grid;
+    const frame::pose& pose = *fv.pose;
     node_C_.assign(std::size_t(nd.size()), Eigen::Matrix3d::Zero());
     node_v0_.resize(std::size_t(nd.size()));
     for (index_t i = 0; i < nd.size(); ++i) node_v0_[std::size_t(i)] = nd.velocity(i);
-    const auto& U = Uf_;
     auto impedance = [&](index_t c) {
-      const double r = U[0][c], mx = U[1][c], my = U[2][c], mz = U[3][c], E = U[4][c];
-      const double p = (gamma_ - 1.0) * (E - 0.5 * (mx * mx + my * my + mz * mz) / r);
+      const double r = fv.density(c), p = fv.pressure(c);
       return std::sqrt(gamma_ * std::max(p, 0.0) * r);  // ρ c
     };
     for (const auto& fr : faces_) {
       const int d = fr.axis;
-      const index_t sy = g.stride(1), sz = g.stride(2), G = fluid::rectilinear_grid::ghosts;
-      const index_t ijk[3] = {fr.high % sz % sy - G, fr.high % sz / sy - G, fr.high / sz - G};
+      const auto ijk = g.ijk(fr.high);
       const int a1 = (d + 1) % 3, a2 = (d + 2) % 3;
       const double area = g.width(a1, ijk[a1]) * g.width(a2, ijk[a2]);
       const double Z = opt_.impedance * (impedance(fr.high - g.stride(d)) + impedance(fr.high));
@@ -466,12 +466,8 @@ class embedded {
   }
 
   void find_faces(const fluid::rectilinear_grid& g, const structure::nodes& nd, const frame::pose& pose) {
-    struct raw {
-      index_t high;
-      int axis;
-      crossing c;
-    };
-    std::vector<raw> found;
+    std::vector<raw_crossing>& found = found_;
+    found.clear();
     area_ = 0;
     for (index_t e = 0; e < index_t(tris_.size()); ++e) {
       if (open_[std::size_t(e)]) continue;
@@ -533,7 +529,7 @@ class embedded {
           }
       }
     }
-    std::sort(found.begin(), found.end(), [](const raw& a, const raw& b) {
+    std::sort(found.begin(), found.end(), [](const raw_crossing& a, const raw_crossing& b) {
       if (a.axis != b.axis) return a.axis < b.axis;
       if (a.high != b.high) return a.high < b.high;
       if (a.c.z != b.c.z) return a.c.z < b.c.z;
@@ -563,16 +559,16 @@ class embedded {
     diag_.crossings = index_t(crossings_.size());
   }
 
-  /// The face handler (called by the solver for every patched face, every RK stage,
-  /// in list order).
-  void face_flux(const fluid::face_context& fc, fluid::cons<double>& lo, fluid::cons<double>& hi) {
-    const std::size_t nf = faces_.size();
-    const std::size_t fi = std::size_t(calls_ % long(nf));
-    const int stage = int(calls_ / long(nf));
-    ++calls_;
+  /// The membrane flux of patched face fc.patch at stage fc.stage.
+  void face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
+                 fluid::cons<double>& hi) {
+    const std::size_t fi = fc.patch;
+    const int stage = fc.stage;
+    require(fi < faces_.size() && stage >= 0 && stage < int(beta_.size()),
+            "coupling::embedded: face ", fi, " at stage ", stage, " is not one of this step's patches");
     const face_rec& fr = faces_[fi];
-    require(fc.high == fr.high && fc.axis == fr.axis && stage < int(beta_.size()),
-            "coupling::embedded: face handler called out of order");
+    require(fc.high == fr.high && fc.axis == fr.axis, "coupling::embedded: patched face ", fi,
+            " does not match the face list of the last exchange");
     const Eigen::Vector3d n(fc.n.x, fc.n.y, fc.n.z);
     // Membrane normal velocity at the crossing (mean over the layers).
     double w = 0;
@@ -580,10 +576,9 @@ class embedded {
     w /= double(fr.n);
     // Cell states on each side (first order).
     auto state = [&](index_t c, double& r, Eigen::Vector3d& u, double& p) {
-      r = Uf_[0][c];
-      const double mx = Uf_[1][c], my = Uf_[2][c], mz = Uf_[3][c], E = Uf_[4][c];
-      u = Eigen::Vector3d(mx, my, mz) / r;
-      p = (gamma_ - 1.0) * (E - 0.5 * (mx * mx + my * my + mz * mz) / r);
+      r = v.density(c);
+      u = v.velocity(c);
+      p = v.pressure(c);
     };
     double rL, pL, rR, pR;
     Eigen::Vector3d uL, uR;
@@ -627,25 +622,9 @@ class embedded {
       }
   }
 
-  template <class Asm, std::size_t... I>
-  static void collect_triangles(const Asm& s, std::vector<std::array<index_t, 3>>& tris, std::index_sequence<I...>) {
-    ((void)[&] {
-      const auto& p = s.template part<I>();
-      using P = std::remove_cvref_t<decltype(p)>;
-      if constexpr (requires { P::corners; p.element(index_t(0)); }) {
-        if constexpr (P::corners == 3)
-          for (index_t e = 0; e < p.size(); ++e) tris.push_back(p.element(e));
-      }
-    }(), ...);
-  }
-
-  Porosity por_{};
-  embedded_options opt_{};
-  std::vector<std::array<index_t, 3>> user_tris_, tris_;
-  bool have_user_tris_ = false;
+  std::vector<detail::triangle> tris_;
   std::vector<index_t> open_list_;
   std::vector<char> open_;
-  bool attached_ = false;
   double dt_f_ = 0, gamma_ = 1.4, area_ = 0, total_kick_ = 1;
   std::vector<face_rec> faces_;
   std::vector<crossing> crossings_;
@@ -653,9 +632,9 @@ class embedded {
   std::vector<Eigen::Matrix3d> node_C_;
   std::vector<index_t> touched_;
   std::vector<double> beta_;
-  long calls_ = 0;
+  std::vector<raw_crossing> found_;           ///< find_faces scratch
+  std::vector<fluid::patch_face> patch_list_;  ///< the faces patched in the coming fluid step
   bool spread_ready_ = false;
-  std::array<const double*, 5> Uf_{};  ///< the fluid's conserved arrays (stage state during a step)
   embedded_diagnostics diag_{};
 };
 

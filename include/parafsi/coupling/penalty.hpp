@@ -59,7 +59,9 @@
 #include "../fluid/solver.hpp"
 #include "../structure/assembly.hpp"
 #include "../structure/nodes.hpp"
+#include "../fluid/view.hpp"
 #include "coupling_points.hpp"
+#include "detail/membrane_coupling.hpp"
 #include "kinds.hpp"
 #include "porosity/impermeable.hpp"
 
@@ -99,29 +101,16 @@ struct penalty_diagnostics {
 };
 
 template <class Porosity = porosity::impermeable>
-class penalty {
+class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, penalty_options> {
+  using base = detail::membrane_coupling<penalty<Porosity>, Porosity, penalty_options>;
+  using base::attached_;
+  using base::opt_;
+  using base::por_;
+
  public:
-  using policy_kind = kind::coupling;
-  using porosity_type = Porosity;
-  static constexpr bool active = true;
   static constexpr const char* name() noexcept { return "penalty"; }
+  using base::base;
 
-  penalty() { opt_.validate(); }
-  explicit penalty(Porosity por, penalty_options opt = {}) : por_(por), opt_(opt) {
-    por_.validate();
-    opt_.validate();
-  }
-
-  /// Couple only these triangles (default: every membrane_tri part of the assembly).
-  penalty& couple(std::vector<std::array<index_t, 3>> triangles) {
-    user_tris_ = std::move(triangles);
-    have_user_tris_ = true;
-    return *this;
-  }
-
-  const Porosity& porosity() const noexcept { return por_; }
-  const penalty_options& options() const noexcept { return opt_; }
-  penalty_options& options() noexcept { return opt_; }
   const coupling_points& points() const noexcept { return pts_; }
   const penalty_diagnostics& diagnostics() const noexcept { return diag_; }
   /// Signed penetration of point c (m).
@@ -159,14 +148,8 @@ class penalty {
   void attach(Fluid& f, Asm& s) {
     f.enable_sources();
     loc_ = grid_locator(f.grid());
-    auto& nd = s.node_set();
-    if (nd.needs_finalize()) s.finalize();
-    std::vector<std::array<index_t, 3>> tris = user_tris_;
-    if (!have_user_tris_) collect_triangles(s, tris, std::make_index_sequence<Asm::part_count>{});
-    for (std::size_t e = 0; e < tris.size(); ++e)
-      for (int a = 0; a < 3; ++a)
-        require(tris[e][std::size_t(a)] >= 0 && tris[e][std::size_t(a)] < nd.size(), "coupling::penalty: triangle ", e,
-                " names node ", tris[e][std::size_t(a)], " outside [0, ", nd.size(), ")");
+    const std::vector<detail::triangle> tris = this->attach_triangles(s);
+    const auto& nd = s.node_set();
     pts_.build(tris, [&](index_t i) { return nd.position(i); }, loc_, f.pose(), opt_.points);
     const index_t n = pts_.size();
     d_.assign(std::size_t(n), 0.0);
@@ -178,48 +161,42 @@ class penalty {
     node_k_.assign(std::size_t(nd.size()), 0.0);
     diag_.through_flow.assign(std::size_t(pts_.elements()), 0.0);
     diag_.relative_flow.assign(std::size_t(pts_.elements()), 0.0);
+    kraw_.assign(std::size_t(n), 0.0);
+    st_.assign(std::size_t(n), stencil{});
     attached_ = true;
   }
 
-  /// Move-frame phase: the box pose at tⁿ with the motion the frame plans for the
-  /// step (the fluid step applies the same plan), used to locate points at each substep.
+  /// Move-frame phase: the box pose at tⁿ with the motion the stepper planned for the
+  /// step (the fluid step applies the same motion), used to locate points at each substep.
   template <class Fluid>
-  void plan(const Fluid& f, double dt_f) {
+  void plan(const Fluid& f, const frame::motion& m) {
     pose_ = f.pose();
-    f.frame().plan(pose_, f.time(), dt_f);
-    planned_ = true;
+    pose_.set_motion(m);
   }
 
-  /// Exchange phase: snapshot the fluid at tⁿ, plan the box motion over the step,
-  /// set stiffness scalings and the substep limit, check the travel per step, clear
-  /// the fluid's source arrays (they collect the impulses of the substeps).
+  /// Exchange phase: snapshot the fluid at tⁿ, set stiffness scalings and the substep
+  /// limit, check the travel per step, clear the fluid's source arrays (they collect
+  /// the impulses of the substeps).
   template <class Fluid, class Asm>
   void exchange(Fluid& f, const Asm& s, double dt_f) {
-    require(attached_, "coupling::penalty: not attached (use it through explicit_stepper)");
+    this->require_attached();
     const auto& g = f.grid();
-    if (!planned_) plan(f, dt_f);
-    planned_ = false;
     // Fluid snapshot (inertial velocity, bulk modulus, density) on interior cells.
     const index_t N = g.total_cells();
     if (index_t(u_[0].size()) != N)
       for (auto* a : {&u_[0], &u_[1], &u_[2], &K_, &rho_}) a->assign(std::size_t(N), 0.0);
-    const auto& U = f.conserved_storage();
-    const double* r = U.template get<fluid::field::rho>();
-    const double* mx = U.template get<fluid::field::mx>();
-    const double* my = U.template get<fluid::field::my>();
-    const double* mz = U.template get<fluid::field::mz>();
-    const double* E = U.template get<fluid::field::E>();
-    const auto& gas = f.gas();
+    const fluid::view fv = f.view();
     const index_t nx = g.n(0), ny = g.n(1), nz = g.n(2);
     parallel::for_range(0, ny * nz, [&](index_t row) {
       const index_t base = g.index(0, row % ny, row / ny);
       for (index_t i = 0; i < nx; ++i) {
         const index_t c = base + i;
-        u_[0][std::size_t(c)] = mx[c] / r[c];
-        u_[1][std::size_t(c)] = my[c] / r[c];
-        u_[2][std::size_t(c)] = mz[c] / r[c];
-        K_[std::size_t(c)] = gas.gamma * gas.pressure(r[c], mx[c], my[c], mz[c], E[c]);
-        rho_[std::size_t(c)] = r[c];
+        const Eigen::Vector3d u = fv.velocity(c);
+        u_[0][std::size_t(c)] = u.x();
+        u_[1][std::size_t(c)] = u.y();
+        u_[2][std::size_t(c)] = u.z();
+        K_[std::size_t(c)] = fv.bulk_modulus(c);
+        rho_[std::size_t(c)] = fv.density(c);
       }
     });
     // Clear the source arrays (they accumulate impulses until finish()).
@@ -233,8 +210,8 @@ class penalty {
     const index_t n = pts_.size();
     if (opt_.fluid_cap > 0 && index_t(ksum_.size()) != N) ksum_.assign(std::size_t(N), 0.0);
     std::fill(node_k_.begin(), node_k_.end(), 0.0);
-    std::vector<double> kraw(static_cast<std::size_t>(n), 0.0);
-    std::vector<stencil> st(static_cast<std::size_t>(n));
+    std::vector<double>& kraw = kraw_;
+    std::vector<stencil>& st = st_;
     diag_.min_stiffness_scale = 1.0;
     for (index_t e = 0; e < pts_.elements(); ++e) {
       const auto geo = element_geometry(nd, e);
@@ -259,7 +236,7 @@ class penalty {
         const double travel = (vs - wg).norm() * dt_f / sc.h;
         if (travel > opt_.max_cells_per_step)
           throw numerical_failure(
-              detail::concat("coupling::penalty: membrane element ", e, " moves ", (vs - wg).norm(),
+              parafsi::detail::concat("coupling::penalty: membrane element ", e, " moves ", (vs - wg).norm(),
                              " m/s relative to the fluid grid, ", travel, " cells of size ", sc.h, " m in one fluid step of ",
                              dt_f, " s (limit ", opt_.max_cells_per_step,
                              " cell per step); the coupling would skip cells: reduce the time step (explicit_stepper::"
@@ -274,7 +251,7 @@ class penalty {
         for (int a = 0; a < 8; ++a) {
           if (sc.weight(a) <= 0) continue;
           const index_t cell = sc.base + loc_.corner(a);
-          const double vol = cell_volume(g, cell);
+          const double vol = g.cell_volume(cell);
           const double ks = ksum_[std::size_t(cell)];
           if (ks > 0) sfac = std::min(sfac, opt_.fluid_cap * rho_[std::size_t(cell)] * vol / (dt_f * dt_f * ks));
         }
@@ -328,13 +305,40 @@ class penalty {
   /// Coupling forces of one substep at offset tau from tⁿ; adds N_a F to the nodes
   /// through `sink` and −w F Δt̄ (and its work) to the fluid impulse arrays.
   void apply(structure::load_sink& sink, const structure::nodes& nd, double tau, double dt_kick, double dt_s) {
+    const bool damped = opt_.damping_ratio > 0, stiffened = opt_.stiffening > 0;
+    if (damped && stiffened) apply_points<true, true>(sink, nd, tau, dt_kick, dt_s);
+    else if (damped) apply_points<true, false>(sink, nd, tau, dt_kick, dt_s);
+    else if (stiffened) apply_points<false, true>(sink, nd, tau, dt_kick, dt_s);
+    else apply_points<false, false>(sink, nd, tau, dt_kick, dt_s);
+  }
+
+  /// Turn the accumulated impulses into the fluid sources S = (J, W)/(Δt_f V_cell).
+  template <class Fluid>
+  void finish(Fluid& f, double dt_f) {
+    const auto& g = f.grid();
+    const index_t nx = g.n(0), ny = g.n(1), nz = g.n(2);
+    const double inv_dt = 1.0 / dt_f;
+    parallel::for_range(0, ny * nz, [&](index_t row) {
+      const index_t j = row % ny, k = row / ny;
+      const index_t base = g.index(0, j, k);
+      for (index_t i = 0; i < nx; ++i) {
+        const double s = inv_dt / g.cell_volume(i, j, k);
+        for (int q = 0; q < 4; ++q) src_[std::size_t(q)][base + i] *= s;
+      }
+    });
+  }
+
+ private:
+  /// The substep's point loop; damping and stiffening chosen once per call.
+  template <bool Damped, bool Stiffened>
+  void apply_points(structure::load_sink& sink, const structure::nodes& nd, double tau, double dt_kick, double dt_s) {
     frame::pose pz = pose_;
     if (tau > 0 && (pz.V.squaredNorm() > 0 || pz.Omega.squaredNorm() > 0)) pz.advance(tau);
     double* sx = src_[0];
     double* sy = src_[1];
     double* sz = src_[2];
     double* sE = src_[3];
-    const double z = opt_.damping_ratio;
+    [[maybe_unused]] const double z = opt_.damping_ratio;
     index_t active = 0;
     area_ = 0;
     for (index_t e = 0; e < pts_.elements(); ++e) {
@@ -367,7 +371,7 @@ class penalty {
         const Eigen::Vector3d vs = point_velocity(geo, c);
         const double vrn = (vf - vs).dot(nrm);
         double k = opt_.pfac * K * Ac / sc.h * scale_[std::size_t(c)];
-        if (opt_.stiffening > 0) {
+        if constexpr (Stiffened) {
           const double q = d / (opt_.stiffening * sc.h);
           k *= 1.0 + q * q;
         }
@@ -377,7 +381,7 @@ class penalty {
         const double ddot = (vrn - up) / (1.0 + dt_s * (k / Ac) * comp);
         d += ddot * dt_s;
         double cdamp = 0;
-        if (z > 0) {
+        if constexpr (Damped) {
           double ms = 0;
           bool any_free = false;
           for (int a = 0; a < 3; ++a) {
@@ -420,23 +424,6 @@ class penalty {
     diag_.inactive_points = pts_.size() - active;
   }
 
-  /// Turn the accumulated impulses into the fluid sources S = (J, W)/(Δt_f V_cell).
-  template <class Fluid>
-  void finish(Fluid& f, double dt_f) {
-    const auto& g = f.grid();
-    const index_t nx = g.n(0), ny = g.n(1), nz = g.n(2);
-    const double inv_dt = 1.0 / dt_f;
-    parallel::for_range(0, ny * nz, [&](index_t row) {
-      const index_t j = row % ny, k = row / ny;
-      const index_t base = g.index(0, j, k);
-      for (index_t i = 0; i < nx; ++i) {
-        const double s = inv_dt / g.cell_volume(i, j, k);
-        for (int q = 0; q < 4; ++q) src_[std::size_t(q)][base + i] *= s;
-      }
-    });
-  }
-
- private:
   struct elem_geo {
     std::array<index_t, 3> id;
     std::array<Eigen::Vector3d, 3> x, v;
@@ -467,35 +454,13 @@ class penalty {
     for (int q = 0; q < 8; ++q) v += s.weight(q) * a[std::size_t(s.base + loc_.corner(q))];
     return v;
   }
-  static double cell_volume(const fluid::rectilinear_grid& g, index_t cell) {
-    const index_t g2 = fluid::rectilinear_grid::ghosts;
-    const index_t sy = g.stride(1), sz = g.stride(2);
-    const index_t k = cell / sz - g2, j = (cell % sz) / sy - g2, i = cell % sy - g2;
-    return g.cell_volume(i, j, k);
-  }
-  template <class Asm, std::size_t... I>
-  static void collect_triangles(const Asm& s, std::vector<std::array<index_t, 3>>& tris, std::index_sequence<I...>) {
-    ((void)[&] {
-      const auto& p = s.template part<I>();
-      using P = std::remove_cvref_t<decltype(p)>;
-      if constexpr (requires { P::corners; p.element(index_t(0)); }) {
-        if constexpr (P::corners == 3)
-          for (index_t e = 0; e < p.size(); ++e) tris.push_back(p.element(e));
-      }
-    }(), ...);
-  }
-
-  Porosity por_{};
-  penalty_options opt_{};
-  std::vector<std::array<index_t, 3>> user_tris_;
-  bool have_user_tris_ = false;
-  bool attached_ = false;
-  bool planned_ = false;
   grid_locator loc_;
   coupling_points pts_;
   std::vector<double> d_, scale_, node_wsum_, node_k_, ksum_;
   std::array<std::vector<double>, 3> u_;
   std::vector<double> K_, rho_;
+  std::vector<double> kraw_;  ///< per point: stiffness before capping (exchange scratch)
+  std::vector<stencil> st_;   ///< per point: stencil at tⁿ (exchange scratch)
   std::array<double*, 4> src_{};
   frame::pose pose_{};
   double dt_struct_ = std::numeric_limits<double>::infinity();

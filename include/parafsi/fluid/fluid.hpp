@@ -5,6 +5,7 @@
 
 #include "boundary/condition.hpp"
 #include "exact_riemann.hpp"
+#include "fields.hpp"
 #include "flux/ale.hpp"
 #include "flux/ausm_plus_up.hpp"
 #include "flux/hllc.hpp"
@@ -16,6 +17,7 @@
 #include "frame/translate.hpp"
 #include "gas.hpp"
 #include "grid.hpp"
+#include "patch.hpp"
 #include "pressure_scaling.hpp"
 #include "reconstruction/first_order.hpp"
 #include "reconstruction/muscl.hpp"
@@ -25,6 +27,7 @@
 #include "turbulence/none.hpp"
 #include "turbulence/prandtl_mixing_length.hpp"
 #include "turbulence/smagorinsky.hpp"
+#include "view.hpp"
 #include "viscosity/constant.hpp"
 #include "viscosity/inviscid.hpp"
 #include "viscosity/sutherland.hpp"

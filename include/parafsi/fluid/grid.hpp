@@ -99,6 +99,10 @@ class rectilinear_grid {
   index_t index(index_t i, index_t j, index_t k) const noexcept {
     return (i + ghosts) + sy_ * (j + ghosts) + sz_ * (k + ghosts);
   }
+  /// Axis indices (i, j, k) of the cell at flat index c (the inverse of index()).
+  std::array<index_t, 3> ijk(index_t c) const noexcept {
+    return {c % sy_ - ghosts, (c % sz_) / sy_ - ghosts, c / sz_ - ghosts};
+  }
   const axis& axis_of(int d) const noexcept { return axes_[d]; }
 
   // Per-axis arrays indexed by cell index + ghosts (i.e. position 0 is cell −2).
@@ -114,6 +118,11 @@ class rectilinear_grid {
   const double* inv_centre_gaps(int d) const noexcept { return idc_[d].data() + ghosts; }
   double cell_volume(index_t i, index_t j, index_t k) const noexcept {
     return width(0, i) * width(1, j) * width(2, k);
+  }
+  /// Volume of the cell at flat index c.
+  double cell_volume(index_t c) const noexcept {
+    const auto q = ijk(c);
+    return cell_volume(q[0], q[1], q[2]);
   }
   double min_width() const noexcept {
     double h = 1e300;

@@ -11,6 +11,12 @@
 
 namespace parafsi::frame {
 
+/// The box motion over one step, as a frame plans it: constant V and Ω.
+struct motion {
+  Eigen::Vector3d V = Eigen::Vector3d::Zero();      ///< velocity of the box origin (m/s)
+  Eigen::Vector3d Omega = Eigen::Vector3d::Zero();  ///< angular velocity (rad/s, inertial)
+};
+
 struct pose {
   Eigen::Vector3d X = Eigen::Vector3d::Zero();       ///< box origin (m, inertial)
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();   ///< box axes as columns
@@ -21,6 +27,13 @@ struct pose {
   Eigen::Vector3d to_box(const Eigen::Vector3d& x) const { return R.transpose() * (x - X); }
   /// Grid velocity at box point ξ (inertial components).
   Eigen::Vector3d grid_velocity(const Eigen::Vector3d& xi) const { return V + Omega.cross(R * xi); }
+
+  /// Take a planned motion for the coming step.
+  void set_motion(const motion& m) {
+    V = m.V;
+    Omega = m.Omega;
+  }
+  motion current_motion() const { return {V, Omega}; }
 
   void advance(double dt) {
     X += V * dt;

@@ -1,0 +1,68 @@
+/// \file ghosts.hpp
+/// Ghost cells of every box face from its boundary condition (boundary/*.hpp): x faces
+/// over interior (j, k); y faces over all i (ghosts included) and interior k; z faces
+/// over all (i, j), so edges and corners get filled. Periodic faces copy the opposite
+/// interior layers; the others get cond.ghost(W_mirror, W_adjacent, n_out, w_n, gas, t)
+/// with w_n the grid's outward normal speed at the boundary face centre.
+#pragma once
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include "../boundary/condition.hpp"
+#include "../gas.hpp"
+#include "../grid.hpp"
+#include "stage.hpp"
+
+namespace parafsi::fluid::detail {
+
+inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
+                        const stage_geometry& geo, double t, const fields5<double>& U, bool threaded) {
+  constexpr index_t ng = rectilinear_grid::ghosts;
+  const index_t n[3] = {grid.n(0), grid.n(1), grid.n(2)};
+  for (int d = 0; d < 3; ++d) {
+    const int a = (d + 1) % 3, b = (d + 2) % 3;
+    // Ranges of the two transverse axes.
+    auto range = [&](int axis) -> std::pair<index_t, index_t> {
+      if (axis < d) return {-ng, n[axis] + ng};  // already filled axes: include ghosts
+      return {0, n[axis]};
+    };
+    const auto ra = range(a), rb = range(b);
+    for (int hi = 0; hi < 2; ++hi) {
+      const auto& bc = bcs.face[std::size_t(2 * d + hi)];
+      const vec3<double> nout = geo.n[std::size_t(d)] * (hi ? 1.0 : -1.0);
+      std::visit([&](const auto& cond) {
+        using C = std::decay_t<decltype(cond)>;
+        par_for(threaded, rb.first, rb.second, [&](index_t q) {
+          for (index_t pidx = ra.first; pidx < ra.second; ++pidx) {
+            for (index_t g = 1; g <= ng; ++g) {
+              index_t ijk_g[3], ijk_m[3], ijk_a[3];
+              ijk_g[a] = ijk_m[a] = ijk_a[a] = pidx;
+              ijk_g[b] = ijk_m[b] = ijk_a[b] = q;
+              ijk_g[d] = hi ? n[d] - 1 + g : -g;
+              if constexpr (std::is_same_v<C, boundary::periodic>) {
+                ijk_m[d] = hi ? g - 1 : n[d] - g;
+                const index_t cg = grid.index(ijk_g[0], ijk_g[1], ijk_g[2]);
+                const index_t cm = grid.index(ijk_m[0], ijk_m[1], ijk_m[2]);
+                store_cons(U, cg, load_cons(U, cm));
+              } else {
+                ijk_m[d] = hi ? n[d] - g : g - 1;  // mirror image of the ghost
+                ijk_a[d] = hi ? n[d] - 1 : 0;      // boundary (adjacent) interior cell
+                const index_t cg = grid.index(ijk_g[0], ijk_g[1], ijk_g[2]);
+                const auto wm = to_prim(load_cons(U, grid.index(ijk_m[0], ijk_m[1], ijk_m[2])), gas);
+                const auto wa = to_prim(load_cons(U, grid.index(ijk_a[0], ijk_a[1], ijk_a[2])), gas);
+                // Grid normal speed at the boundary face centre (outward normal).
+                Eigen::Vector3d xi{grid.centre(0, ijk_a[0]), grid.centre(1, ijk_a[1]), grid.centre(2, ijk_a[2])};
+                xi[d] = hi ? grid.face(d, n[d]) : grid.face(d, 0);
+                const double wn = (hi ? 1.0 : -1.0) * (geo.vh[d] + geo.oh.cross(xi)[d]);
+                store_cons(U, cg, to_cons(cond.ghost(wm, wa, nout, wn, gas, t), gas));
+              }
+            }
+          }
+        });
+      }, bc);
+    }
+  }
+}
+
+}  // namespace parafsi::fluid::detail

@@ -1,0 +1,75 @@
+/// \file sources.hpp
+/// Volume sources and the far-field sponge:
+///   dU += S − σ (U − U_∞),
+/// S the per-cell sources (the coupling's impulses, per unit volume and time; mass,
+/// momentum, energy), σ the sponge rate, ramping as σ = s c_∞/L_s ((L − dist)/L)³ into
+/// the last L cells before every far-field face (L_s the layer's thickness, c_∞ and U_∞
+/// the first far-field face's sound speed and state). Which terms are present is chosen
+/// once per call (template flags), not per cell.
+#pragma once
+#include <algorithm>
+#include <variant>
+
+#include "../boundary/condition.hpp"
+#include "../gas.hpp"
+#include "../grid.hpp"
+#include "stage.hpp"
+
+namespace parafsi::fluid::detail {
+
+/// Fill the sponge rate σ on interior cells; returns the sponge's target state.
+inline cons<double> setup_sponge(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
+                                 double* sig, const cons<double>& fallback) {
+  const index_t L = bcs.layer.cells;
+  double cinf = 340.0;
+  for (const auto& f : bcs.face)
+    if (auto* ff = std::get_if<boundary::far_field>(&f)) {
+      cinf = gas.sound_speed(ff->rho, ff->p);
+      break;
+    }
+  for (index_t k = 0; k < grid.n(2); ++k)
+    for (index_t j = 0; j < grid.n(1); ++j)
+      for (index_t i = 0; i < grid.n(0); ++i) {
+        const index_t ijk[3] = {i, j, k};
+        double s = 0.0;
+        for (int d = 0; d < 3; ++d)
+          for (int hi = 0; hi < 2; ++hi) {
+            if (!std::holds_alternative<boundary::far_field>(bcs.face[std::size_t(2 * d + hi)])) continue;
+            const index_t dist = hi ? grid.n(d) - 1 - ijk[d] : ijk[d];  // cells from the face
+            if (dist >= L) continue;
+            double thick = 0.0;
+            for (index_t q = 0; q < L && q < grid.n(d); ++q) thick += grid.width(d, hi ? grid.n(d) - 1 - q : q);
+            const double xi = double(L - dist) / double(L);
+            s = std::max(s, bcs.layer.strength * cinf / thick * xi * xi * xi);
+          }
+        sig[grid.index(i, j, k)] = s;
+      }
+  // Target state: the first far-field face's state.
+  for (const auto& f : bcs.face)
+    if (auto* ff = std::get_if<boundary::far_field>(&f)) return to_cons(ff->state(), gas);
+  return fallback;
+}
+
+/// dU += S (Sources) and dU −= σ (U − U_∞) (Sponge) on interior cells. `src` in the
+/// order (ρ, mx, my, mz, E).
+template <bool Sources, bool Sponge>
+void add_sources(const rectilinear_grid& grid, const fields5<double>& dU, const fields5<const double>& U,
+                 const fields5<const double>& src, const double* sig, const cons<double>& target, bool threaded) {
+  const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
+  const double tgt[5] = {target.rho, target.m.x, target.m.y, target.m.z, target.E};
+  par_for(threaded, 0, ny * nz, [&](index_t r) {
+    const index_t base = grid.index(0, r % ny, r / ny);
+    for (index_t i = 0; i < nx; ++i) {
+      const index_t c = base + i;
+      if constexpr (Sources)
+        for (int f = 0; f < 5; ++f) dU[f][c] += src[f][c];
+      if constexpr (Sponge) {
+        const double s = sig[c];
+        if (s > 0.0)
+          for (int f = 0; f < 5; ++f) dU[f][c] -= s * (U[f][c] - tgt[f]);
+      }
+    }
+  });
+}
+
+}  // namespace parafsi::fluid::detail

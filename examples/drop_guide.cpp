@@ -86,21 +86,22 @@ int main(int argc, char** argv) {
     po.stiffening = 0.25;
     pf::coupling::penalty coupling{pf::porosity::ergun{S.fabric.alpha, S.fabric.beta, S.fabric.thickness}, po};
 
-    // 5. The coupled stepper owns the three parts from here on.
-    pf::explicit_stepper s{std::move(fluid), std::move(chute), std::move(coupling)};
+    // 5. The coupled stepper owns the three parts from here on. Its frame target moves the
+    //    box after the payload: before every step, the payload's mass centre extrapolated to
+    //    the end of the step under gravity, track(x + v dt, v + g dt).
+    pf::explicit_stepper s{std::move(fluid), std::move(chute), std::move(coupling),
+                           pf::follow_body{pf::scene::drop_payload_body{}, S.params.gravity}};
     const long cells = long(grid.n(0)) * grid.n(1) * grid.n(2);
     std::printf("drop_guide: %s, %ldx%ldx%ld = %ld cells, %ld nodes, %zu triangles, t_end %g s\n",
                 std::string(S.fabric.name).c_str(), long(grid.n(0)), long(grid.n(1)), long(grid.n(2)), cells,
                 long(s.structure().node_set().size()), S.triangles.size(), t_end);
 
     // 6. The time loop, up to an instant `target`. Each pass: the stable step (shortened to
-    //    land on the target), the box's target at the end of the step (the payload's
-    //    position and velocity extrapolated under gravity), the coupled step.
+    //    land on the target), the coupled step.
     const double cfl = 0.9;
     auto advance_to = [&](double target) {
       while (s.time() < target - 1e-12) {
         const double dt = pf::scene::landing_step(s.stable_dt(cfl), target - s.time());
-        pf::scene::track_payload(s, dt);
         s.step(dt);
       }
     };

@@ -13,7 +13,7 @@
 ///   make_drop_setup(c)    the plain data: scene parameters after the overrides, the
 ///                         resolution, the scene, the fluid box, α
 ///   scene/drop_steps.hpp  make_drop_grid(box), place_drop_box(fluid, box, assembly),
-///                         track_payload(stepper, dt), landing_step(dt, left): the steps
+///                         drop_frame_target<Fluid>(g), landing_step(dt, left): the steps
 ///                         a program that builds the drop itself shares with run_drop
 ///
 /// Scene: the model's values (paper: released at rest from 35 m, flight path 90°,
@@ -31,7 +31,8 @@
 ///
 /// Loop (each step): the stable step at `cfl`, shortened to land on the next output
 /// instant n · history_every (an integer n, so a restarted run takes the steps of the
-/// uninterrupted one); the box target (`track_payload`); the coupled step. At each output
+/// uninterrupted one); the coupled step (the stepper moves the box after the payload:
+/// its frame target, `drop_frame_target`). At each output
 /// instant: a history row (checked for non-finite nodes), the αM guard (a warning once
 /// when α |v_payload| / c > 0.3), VTK and checkpoint at their intervals, the slices due.
 /// Stops with numerical_failure when the stable step collapses below 1e-9 history_every
@@ -226,12 +227,12 @@ namespace detail {
 template <class Fluid, class Coupling>
 class drop_run {
  public:
-  using stepper_type = explicit_stepper<Fluid, structure::drop_assembly, Coupling>;
+  using stepper_type = explicit_stepper<Fluid, structure::drop_assembly, Coupling, drop_frame_target_t<Fluid>>;
 
   drop_run(const drop_config& c, const drop_setup& su, Fluid&& f, structure::drop_assembly&& a, Coupling&& cpl)
       : c_(c),
         su_(su),
-        s_(std::move(f), std::move(a), std::move(cpl)),
+        s_(std::move(f), std::move(a), std::move(cpl), drop_frame_target<Fluid>(su.params.gravity)),
         observe_(su.scene),
         pgs_{su.alpha},
         p_offset_(pgs_.pressure_offset(su.params.air_pressure)),
@@ -274,7 +275,6 @@ class drop_run {
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
       const double dt = next_step(std::min(next_out, c_.t_end));
-      track_payload(s_, dt);
       check_fixed_box();
       s_.step(dt);
       substeps += s_.last_substeps();

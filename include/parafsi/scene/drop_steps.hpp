@@ -4,18 +4,18 @@
 ///
 ///   make_drop_grid(box)               the rectilinear grid of a model::drop_box
 ///   place_drop_box(fluid, box, chute) the box pose: axes, payload mass centre, velocity
-///   track_payload(stepper, dt)        the following box's target at the end of the step
+///   drop_frame_target<Fluid>(g)       the stepper's frame target: the payload's mass centre
 ///   landing_step(dt, left)            a step shortened to land on an output instant
 ///
-/// track_payload is the one place of the tracking predictor, x + v dt and v + g dt of the
-/// payload mass centre; a stepper that plans the frame itself from a frame target makes it
-/// unnecessary.
+/// The box motion itself is planned by the stepper (move_frame phase) from the frame target.
 #pragma once
 #include <cstddef>
+#include <type_traits>
 
 #include <Eigen/Core>
 
 #include "../fluid/grid.hpp"
+#include "../frame_target.hpp"
 #include "../model/drop_box.hpp"
 #include "../structure/from_drop_scene.hpp"
 
@@ -43,19 +43,28 @@ void place_drop_box(Fluid& f, const model::drop_box& b, const structure::drop_as
     f.pose().V = body.mass_centre_velocity();
 }
 
-/// The following box's target at the end of the coming step of length dt: the payload
-/// mass centre's position and velocity extrapolated under the structure's gravity,
-/// track(x + v dt, v + g dt) (the payload's own acceleration, which the drag reduces, is
-/// not known before the step). Nothing for a frame without `track` (a fixed box).
-template <class Stepper>
-void track_payload(Stepper& s, double dt) {
-  auto& f = s.fluid();
-  if constexpr (requires(const Eigen::Vector3d& x) { f.frame().track(x, x); }) {
-    const auto& body = structure::payload(s.structure()).body();
-    const Eigen::Vector3d xp = body.mass_centre(), vp = body.mass_centre_velocity();
-    const Eigen::Vector3d g = s.structure().integrator().gravity;
-    f.frame().track(xp + vp * dt, vp + g * dt);
+/// The payload's rigid body of a drop assembly (the body a following box tracks).
+struct drop_payload_body {
+  template <class Assembly>
+  const auto& operator()(const Assembly& a) const {
+    return structure::payload(a).body();
   }
+};
+
+/// The drop's frame target for the explicit_stepper (frame_target.hpp): a box that
+/// follows the payload (a frame with `track`) gets follow_body on the payload's mass
+/// centre, extrapolated to the end of each step under gravity, track(x + v dt, v + g dt)
+/// (the payload's own acceleration, which the drag reduces, is not known before the step);
+/// a fixed box gets none.
+template <class Fluid>
+using drop_frame_target_t =
+    std::conditional_t<requires(Fluid& f, const Eigen::Vector3d& x) { f.frame().track(x, x); },
+                       follow_body<drop_payload_body>, no_frame_target>;
+
+template <class Fluid>
+drop_frame_target_t<Fluid> drop_frame_target(double gravity) {
+  if constexpr (std::is_same_v<drop_frame_target_t<Fluid>, no_frame_target>) return {};
+  else return follow_body<drop_payload_body>{drop_payload_body{}, gravity};
 }
 
 /// The step dt shortened to land on an instant `left` seconds ahead: all of `left` when

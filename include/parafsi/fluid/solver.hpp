@@ -372,11 +372,11 @@ class solver {
       ar.check("grid.axis" + std::to_string(d), self.grid_.axis_of(d).faces,
                [d](const std::vector<double>& file, const std::vector<double>& mine) -> std::string {
                  if (file.size() != mine.size())
-                   return detail::concat("grid axis ", d, " has ", index_t(file.size()) - 1,
+                   return parafsi::detail::concat("grid axis ", d, " has ", index_t(file.size()) - 1,
                                          " cells in the file but ", index_t(mine.size()) - 1, " in this solver");
                  for (std::size_t i = 0; i < file.size(); ++i)
                    if (file[i] != mine[i])
-                     return detail::concat("grid axis ", d, " face ", i, " is at ", file[i], " in the file but ",
+                     return parafsi::detail::concat("grid axis ", d, " face ", i, " is at ", file[i], " in the file but ",
                                            mine[i], " in this solver");
                  return {};
                });

@@ -57,15 +57,14 @@ struct drop_payload_body {
 /// (the payload's own acceleration, which the drag reduces, is not known before the step);
 /// a fixed box gets none.
 template <class Fluid>
-using drop_frame_target_t =
-    std::conditional_t<requires(Fluid& f, const Eigen::Vector3d& x) { f.frame().track(x, x); },
-                       follow_body<drop_payload_body>, no_frame_target>;
-
-template <class Fluid>
-drop_frame_target_t<Fluid> drop_frame_target(double gravity) {
-  if constexpr (std::is_same_v<drop_frame_target_t<Fluid>, no_frame_target>) return {};
-  else return follow_body<drop_payload_body>{drop_payload_body{}, gravity};
+auto drop_frame_target(double gravity) {
+  if constexpr (requires(Fluid& f, const Eigen::Vector3d& x) { f.frame().track(x, x); })
+    return follow_body<drop_payload_body>{drop_payload_body{}, gravity};
+  else
+    return no_frame_target{};
 }
+template <class Fluid>
+using drop_frame_target_t = decltype(drop_frame_target<Fluid>(0.0));
 
 /// The step dt shortened to land on an instant `left` seconds ahead: all of `left` when
 /// dt reaches it, half of it when dt would leave less than a step's sliver, else dt.

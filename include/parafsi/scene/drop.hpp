@@ -145,6 +145,10 @@ struct drop_config {
             "resolution's), got ", growth);
     require(cell >= 0 && element >= 0, "parachute_drop: cell and element sizes must be >= 0 (0: the resolution's), "
             "got ", cell, " and ", element);
+    // Penalty stiffening multiplies the springs by 1 + (d/(λh))², which the stable step does
+    // not see: a tiny λ diverges.
+    require(stiffening == 0 || (stiffening >= 0.01 && stiffening <= 10),
+            "parachute_drop: --stiffening must be 0 (off) or in [0.01, 10], got ", stiffening);
     require(line_stiffness > 0, "parachute_drop: line stiffness scale must be > 0, got ", line_stiffness);
     require(modulus_scale > 0, "parachute_drop: fabric modulus scale must be > 0, got ", modulus_scale);
     require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: --pgs (PGS alpha) must be >= 1 (0: auto), got ", pgs_alpha);

@@ -46,7 +46,13 @@ int main(int argc, char** argv) {
   examples::add_cells_option(app, cells, "fluid cells across the body diameter D = 0.2 m", 4);
   app.add_option("--velocity", U, "free-stream velocity U (m/s)")->check(CLI::Range(1.0, 100.0))->capture_default_str();
   app.add_option("--reynolds", Re, "Reynolds number U D / nu (sets a constant viscosity; 0 = inviscid)")
-      ->check(CLI::Range(0.0, 1e9))
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            double v = 0;
+            if (CLI::detail::lexical_cast(s, v) && (v == 0 || (v >= 1 && v <= 1e9))) return std::string();
+            return "Reynolds number " + s + " is neither 0 (inviscid) nor in [1, 1e9]";
+          },
+          "0 or [1 - 1e9]"))
       ->capture_default_str();
   app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")->check(CLI::Range(1e-4, 1e3))->capture_default_str();
   app.add_option("--flow-times", flow_times, "run length in flow-through times D/U (ignored with --time)")
@@ -104,8 +110,9 @@ int main(int argc, char** argv) {
         examples::csv_writer csv(out, "t,drag_coefficient");
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
         double sum = 0, sum_t = 0, max_pen = 0;
+        examples::step_guard guard("bluff_body_drag", t_end);
         while (s.time() < t_end * (1.0 - 1e-12)) {
-          double dt = s.stable_dt(co.cfl);
+          double dt = guard(s.stable_dt(co.cfl), s.time());
           const double left = t_end - s.time();
           if (dt >= left * (1.0 - 1e-12)) dt = left;
           else if (dt > 0.5 * left) dt = 0.5 * left;

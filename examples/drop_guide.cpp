@@ -15,6 +15,9 @@
 // mid-plane slices, is parachute_drop (scene::run_drop, include/parafsi/scene/drop.hpp),
 // built from the same pieces.
 #include <CLI/CLI.hpp>
+
+#include "cli_checks.hpp"
+#include "step_guard.hpp"
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
 #include <parafsi/io/drop_history.hpp>
@@ -39,7 +42,7 @@ int main(int argc, char** argv) {
   std::string out = "drop_guide";
   app.add_option("--t-end", t_end, "simulated time (s)")->check(CLI::Range(1e-3, 10.0))->capture_default_str();
   app.add_option("--out", out, "output directory (history.csv, summary.csv)")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
   pf::parallel::set_threads(1);
 
   try {
@@ -99,9 +102,10 @@ int main(int argc, char** argv) {
     // 6. The time loop, up to an instant `target`. Each pass: the stable step (shortened to
     //    land on the target), the coupled step.
     const double cfl = 0.9;
+    examples::step_guard guard("drop_guide", t_end);
     auto advance_to = [&](double target) {
       while (s.time() < target - 1e-12) {
-        const double dt = pf::scene::landing_step(s.stable_dt(cfl), target - s.time());
+        const double dt = pf::scene::landing_step(guard(s.stable_dt(cfl), s.time()), target - s.time());
         s.step(dt);
       }
     };

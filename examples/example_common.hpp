@@ -5,7 +5,11 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <parafsi/io/checked_file.hpp>
 #include <parafsi/parafsi.hpp>
+
+#include "cli_checks.hpp"
+#include "step_guard.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -54,17 +58,6 @@ decltype(auto) dispatch(const std::string& flux, const std::string& limiter, F&&
 }
 
 // ---------------------------------------------------------------- options
-/// Validator for floating-point options: refuses NaN and ±inf, naming the value (CLI11
-/// prefixes the option's name). Put it before a CLI::Range, which lets NaN through
-/// (every comparison with NaN is false):  ->check(examples::finite)->check(CLI::Range(a, b)).
-inline const CLI::Validator finite{[](std::string& s) {
-                                     double v = 0;
-                                     if (!CLI::detail::lexical_cast(s, v)) return "'" + s + "' is not a number";
-                                     if (!std::isfinite(v)) return "value " + s + " is not a finite number";
-                                     return std::string();
-                                   },
-                                   ""};
-
 /// Options every example shares.
 struct common_options {
   std::string flux = "hllc_lm";
@@ -102,18 +95,6 @@ inline CLI::Option* add_out_option(CLI::App& app, std::string& out) {
   return app.add_option("--out", out, "CSV output file")->required()->check([](const std::string& s) {
     return s.empty() ? std::string("output file name is empty") : std::string();
   });
-}
-
-/// Parse argv; on --help prints usage and returns 0 through `exit_code`, on a bad
-/// flag prints the message and returns non-zero. Returns true if the run goes on.
-inline bool parse(CLI::App& app, int argc, char** argv, int& exit_code) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    exit_code = app.exit(e);
-    return false;
-  }
-  return true;
 }
 
 inline void apply_threads(const common_options& o) {
@@ -159,11 +140,13 @@ class progress {
   bool printed_ = false;
 };
 
-/// Advance `s` to t_end with the stable step at `cfl` (the last step lands on t_end).
+/// Advance `s` to t_end with the stable step at `cfl` (the last step lands on t_end),
+/// guarded (step_guard: a collapsed step or too many steps stop the run with a message).
 template <class Solver>
 void run_to(Solver& s, double t_end, double cfl, progress& prog) {
+  step_guard guard("run_to", t_end);
   while (s.time() < t_end) {
-    double dt = s.stable_dt(cfl);
+    double dt = guard(s.stable_dt(cfl), s.time());
     const double left = t_end - s.time();
     if (dt >= left * (1.0 - 1e-12)) dt = left;
     else if (dt > 0.5 * left) dt = 0.5 * left;  // avoid a tiny last step
@@ -174,30 +157,30 @@ void run_to(Solver& s, double t_end, double cfl, progress& prog) {
 }
 
 // ---------------------------------------------------------------- CSV
-/// Minimal CSV writer: header, then rows of numbers at full precision.
+/// Minimal CSV writer: header, then rows of numbers at full precision, through
+/// io::checked_file (a failed open, write, flush or close throws io::write_error naming
+/// the file and the system's reason; `close()` must be called).
 class csv_writer {
  public:
-  csv_writer(const std::string& path, const std::string& header) : os_(path) {
-    if (!os_) throw std::runtime_error("cannot open '" + path + "' for writing");
-    os_.precision(15);
-    os_ << header << '\n';
-  }
+  csv_writer(const std::string& path, const std::string& header) : f_(path) { f_.write(header + '\n'); }
   void row(std::initializer_list<double> values) {
+    line_.clear();
+    char buf[32];
     bool first = true;
     for (double v : values) {
-      if (!first) os_ << ',';
-      os_ << v;
+      if (!first) line_ += ',';
+      std::snprintf(buf, sizeof buf, "%.15g", v);
+      line_ += buf;
       first = false;
     }
-    os_ << '\n';
+    line_ += '\n';
+    f_.write(line_);
   }
-  void close() {
-    os_.close();
-    if (!os_) throw std::runtime_error("error writing CSV output");
-  }
+  void close() { f_.close(); }
 
  private:
-  std::ofstream os_;
+  pf::io::checked_file f_;
+  std::string line_;
 };
 
 /// Run `body`, turning exceptions into a message and exit code 1.

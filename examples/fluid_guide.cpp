@@ -11,12 +11,17 @@
 // pressures; with --out writes the line through the payload along the box z axis as
 // CSV `xi_z,x,y,z,rho,ux,uy,uz,p` (box coordinate, inertial position, state).
 #include <CLI/CLI.hpp>
+
+#include "cli_checks.hpp"
+#include "step_guard.hpp"
+#include <parafsi/io/checked_file.hpp>
 #include <parafsi/parafsi.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 namespace pf = parafsi;
@@ -33,7 +38,7 @@ int main(int argc, char** argv) {
   app.add_option("--cfl", cfl, "CFL number of the stable step")->check(CLI::Range(0.01, 1.0))->capture_default_str();
   app.add_option("--threads", threads, "OpenMP threads")->check(CLI::Range(1, 1024))->capture_default_str();
   app.add_option("--out", out, "CSV of the line through the payload along the box z axis");
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
   pf::parallel::set_threads(threads);
 
   try {
@@ -92,8 +97,9 @@ int main(int argc, char** argv) {
 
     // 6. The user's loop: stable step, target of the coming step, sources, step.
     const auto before = s.totals();
+    examples::step_guard guard("fluid_guide", t_end);
     while (s.time() < t_end) {
-      const double dt = std::min(s.stable_dt(cfl), t_end - s.time());
+      const double dt = std::min(guard(s.stable_dt(cfl), s.time()), t_end - s.time());
       s.frame().track(payload(s.time() + dt), v);
       set_sources();
       s.step(dt);
@@ -129,7 +135,7 @@ int main(int argc, char** argv) {
         return best;
       };
       const pf::index_t i = nearest(0), j = nearest(1);
-      std::ofstream csv(out);
+      std::ostringstream csv;  // written through io::checked_file below
       csv.precision(12);
       csv << "xi_z,x,y,z,rho,ux,uy,uz,p\n";
       for (pf::index_t k = 0; k < grid.n(2); ++k) {
@@ -138,7 +144,7 @@ int main(int argc, char** argv) {
         csv << grid.centre(2, k) << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << w.rho << ',' << w.u.x
             << ',' << w.u.y << ',' << w.u.z << ',' << w.p << '\n';
       }
-      if (!csv) throw pf::invalid_input("cannot write '" + out + "'");
+      pf::io::write_text_file(out, csv.str());
     }
   } catch (const pf::numerical_failure& e) {
     std::fprintf(stderr, "fluid_guide: %s (storage index %ld, t = %g s)\n", e.what(), e.index, e.t);

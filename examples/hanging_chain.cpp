@@ -8,14 +8,18 @@
 // `max_deviation_over_span=<value>` against the catenary on stdout, progress on stderr.
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <sstream>
 #include <string>
 
 #include <parafsi/core/parallel.hpp>
+#include <parafsi/io/checked_file.hpp>
 #include <parafsi/structure/assembly.hpp>
 #include <parafsi/structure/cable.hpp>
 #include <parafsi/structure/reference/catenary.hpp>
@@ -29,10 +33,10 @@ int main(int argc, char** argv) {
   double L = 0, S = 0, EA = 1e4, rho_l = 0.1, xi = 0.2, tol = 1e-10;
   std::string out;
   app.add_option("--links", links, "number of cable elements N")->required()->check(CLI::Range(2, 100000));
-  app.add_option("--length", L, "unstretched chain length L (m)")->required()->check(CLI::PositiveNumber);
-  app.add_option("--span", S, "distance S between the supports (m), S < L")->required()->check(CLI::PositiveNumber);
-  app.add_option("--EA", EA, "axial stiffness (N)")->check(CLI::PositiveNumber)->capture_default_str();
-  app.add_option("--mass-per-length", rho_l, "kg/m")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--length", L, "unstretched chain length L (m)")->required()->check(CLI::Range(1e-3, 1e4));
+  app.add_option("--span", S, "distance S between the supports (m), S < L")->required()->check(CLI::Range(1e-3, 1e4));
+  app.add_option("--EA", EA, "axial stiffness (N)")->check(CLI::Range(1e-3, 1e12))->capture_default_str();
+  app.add_option("--mass-per-length", rho_l, "kg/m")->check(CLI::Range(1e-6, 1e4))->capture_default_str();
   app.add_option("--damping-ratio", xi, "axial damping ratio of each link")
       ->check(CLI::Range(0.0, 0.99))
       ->capture_default_str();
@@ -41,7 +45,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threads", threads, "OpenMP threads")->check(CLI::Range(1, 1024))->capture_default_str();
   app.add_option("--out", out, "CSV file (x,z)")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
   if (!(S < L)) {
     std::fprintf(stderr, "hanging_chain: --span %g must be smaller than --length %g\n", S, L);
     return 1;
@@ -82,11 +86,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "hanging_chain: not at rest after t = %.3e s\n", r.time);
       return 2;
     }
-    std::ofstream f(out);
-    if (!f) {
-      std::fprintf(stderr, "hanging_chain: cannot open '%s' for writing\n", out.c_str());
-      return 1;
-    }
+    std::ostringstream f;  // written through io::checked_file below
     f.precision(10);
     f << "x,z\n";
     double dev = 0;
@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
       f << x.x() << "," << x.z() << "\n";
       dev = std::max(dev, std::abs(x.z() - cat.z(x.x())));
     }
+    parafsi::io::write_text_file(out, f.str());
     std::fprintf(stderr, "hanging_chain: at rest after %ld steps, t = %.4e s\n", r.steps, r.time);
     std::printf("mid_sag=%.10g\ncatenary_sag=%.10g\nmax_deviation_over_span=%.6e\n",
                 -chain.node_set().position(links / 2).z(), cat.sag(), dev / S);

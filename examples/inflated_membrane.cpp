@@ -14,15 +14,19 @@
 // rim row: the rim nodes).
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <parafsi/core/parallel.hpp>
+#include <parafsi/io/checked_file.hpp>
 #include <parafsi/model/disk_mesh.hpp>
 #include <parafsi/model/disk_quad_mesh.hpp>
 #include <parafsi/structure/assembly.hpp>
@@ -39,16 +43,16 @@ int main(int argc, char** argv) {
   double a = 0, h = 0, E = 0, nu = 0, p = 0, density = 1000.0, tol = 1e-12;
   int rings = 20, threads = 1;
   std::string out, element = "tri";
-  app.add_option("--radius", a, "membrane radius A (m)")->required()->check(CLI::PositiveNumber);
-  app.add_option("--thickness", h, "thickness H (m)")->required()->check(CLI::PositiveNumber);
-  app.add_option("--E", E, "Young's modulus (Pa)")->required()->check(CLI::PositiveNumber);
+  app.add_option("--radius", a, "membrane radius A (m)")->required()->check(CLI::Range(1e-4, 1e3));
+  app.add_option("--thickness", h, "thickness H (m)")->required()->check(CLI::Range(1e-7, 1.0));
+  app.add_option("--E", E, "Young's modulus (Pa)")->required()->check(CLI::Range(1e3, 1e13));
   app.add_option("--nu", nu, "Poisson ratio in [0, 0.5)")->required()->check(CLI::Range(0.0, 0.4999));
-  app.add_option("--pressure", p, "uniform pressure (Pa)")->required()->check(CLI::PositiveNumber);
+  app.add_option("--pressure", p, "uniform pressure (Pa)")->required()->check(CLI::Range(1e-3, 1e8));
   app.add_option("--elements", rings, "radial divisions N (6 N^2 triangles)")
       ->check(CLI::Range(2, 400))
       ->capture_default_str();
   app.add_option("--density", density, "material density (kg/m^3); statics do not depend on it")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1e-3, 1e5))
       ->capture_default_str();
   app.add_option("--tolerance", tol, "stop when kinetic energy < tolerance x its peak")
       ->check(CLI::Range(1e-20, 1e-2))
@@ -58,7 +62,7 @@ int main(int argc, char** argv) {
   app.add_option("--element", element, "membrane element: tri (CST) or quad (Belytschko-Tsay)")
       ->check(CLI::IsMember({"tri", "quad"}))
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
 
   try {
     // One run for either element part (same loads, damping, relaxation and output).
@@ -98,11 +102,7 @@ int main(int argc, char** argv) {
       const double w0 = chute.node_set().position(centre).z();
       std::fprintf(stderr, "inflated_membrane: at rest after %ld steps, t = %.4e s\n", r.steps, r.time);
 
-      std::ofstream f(out);
-      if (!f) {
-        std::fprintf(stderr, "inflated_membrane: cannot open '%s' for writing\n", out.c_str());
-        return 1;
-      }
+      std::ostringstream f;  // written through io::checked_file below
       f.precision(10);
       f << "r,w\n" << 0.0 << "," << w0 << "\n";
       std::vector<double> sum(std::size_t(rings) + 1, 0.0), count(std::size_t(rings) + 1, 0.0);
@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
         count[std::size_t(bin[i])] += 1;
       }
       for (int k = 1; k <= rings; ++k) f << a * k / rings << "," << sum[std::size_t(k)] / count[std::size_t(k)] << "\n";
+      parafsi::io::write_text_file(out, f.str());
       std::printf("centre_deflection=%.10g\n", w0);
       std::printf("hencky_centre_deflection=%.10g\n", w_hencky);
       std::printf("relative_error=%.6e\n", w0 / w_hencky - 1.0);

@@ -30,8 +30,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   examples::add_cells_option(app, cells, "cells along the 1 m box", 10);
   app.add_option("--pfac", pfac, "penalty factor PFAC")->check(CLI::Range(1e-4, 1e3))->capture_default_str();
+  // λ > 0 stiffens the springs by (d/(λh))², which the stable step does not see: a tiny λ
+  // would diverge, so 0 (off) or [0.01, 10].
   app.add_option("--stiffening", stiffening, "nonlinear stiffening lambda (0 = off)")
-      ->check(CLI::Range(0.0, 10.0))
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            double v = 0;
+            if (CLI::detail::lexical_cast(s, v) && (v == 0 || (v >= 0.01 && v <= 10))) return std::string();
+            return "stiffening " + s + " is neither 0 (off) nor in [0.01, 10]";
+          },
+          "0 or [0.01 - 10]"))
       ->capture_default_str();
   app.add_option("--time", t_end, "simulated time (s)")->check(CLI::Range(1e-4, 10.0))->capture_default_str();
   examples::add_out_option(app, out);
@@ -82,8 +90,9 @@ int main(int argc, char** argv) {
       examples::progress prog("leak_box", t_end, co.quiet);
       double t_prev = 0, mr_prev = mr0, mr_half = mr0, t_half = -1, max_pen = 0;
       long next_row = 0;
+      examples::step_guard guard("leak_box", t_end);
       while (s.time() < t_end - 1e-15) {
-        s.step(std::min(s.stable_dt(co.cfl), t_end - s.time()));
+        s.step(std::min(guard(s.stable_dt(co.cfl), s.time()), t_end - s.time()));
         max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
         if (t_half < 0 && s.time() >= 0.5 * t_end) {
           halves(ml, mr_half, pl, pr);

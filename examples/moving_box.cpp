@@ -79,7 +79,7 @@ int run(const options& o) {
   std::printf("velocity_deviation_over_sound_speed=%.3e\n", du / c);
   std::printf("wall_seconds=%.3f\n", wall);
   const bool ok = rel_u <= o.tolerance && rel_p <= o.tolerance;
-  std::printf("free_stream_preservation=%s (tolerance %.0e relative)\n", ok ? "PASS" : "FAIL", o.tolerance);
+  std::printf("free_stream_preservation=%s (--tolerance %.0e relative)\n", ok ? "PASS" : "FAIL", o.tolerance);
   return ok ? 0 : 1;
 }
 

@@ -33,6 +33,7 @@
 
 #include <parafsi/scene/drop.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -60,6 +61,7 @@ std::vector<double> parse_list(const std::string& s) {
                                  "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
     v.push_back(t);
   }
+  std::sort(v.begin(), v.end());  // slices are written in time order
   return v;
 }
 

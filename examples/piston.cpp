@@ -64,8 +64,9 @@ int main(int argc, char** argv) {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
         examples::progress prog("piston", t_end, co.quiet);
         double max_pen = 0;
+        examples::step_guard guard("piston", t_end);
         while (s.time() < t_end - 1e-15) {
-          s.step(std::min(s.stable_dt(co.cfl), t_end - s.time()));
+          s.step(std::min(guard(s.stable_dt(co.cfl), s.time()), t_end - s.time()));
           max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
           prog(s.time(), s.steps());
         }

@@ -88,8 +88,9 @@ int main(int argc, char** argv) {
       double dp = 0, u = 0;
       long next_row = 0;
       double max_pen = 0;
+      examples::step_guard guard("porous_screen", t_end);
       while (s.time() < t_end - 1e-15) {
-        s.step(std::min(s.stable_dt(co.cfl), t_end - s.time()));
+        s.step(std::min(guard(s.stable_dt(co.cfl), s.time()), t_end - s.time()));
         max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
         if (s.steps() >= next_row) {
           measure(dp, u);

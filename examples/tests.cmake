@@ -254,3 +254,48 @@ parafsi_example_refuses(example_parachute_drop_huge_grid parachute_drop "" "woul
   --cell 1e-3)
 parafsi_example_refuses(example_parachute_drop_tiny_element parachute_drop "" "would give more than 1e308 triangles"
   --element 1e-300)
+
+# ---- Every program that writes: a file on a full device (/dev/full accepts the open and
+# fails every write with ENOSPC) and a path under a regular file (refused at the open,
+# also for root, which a read-only directory would not stop) exit non-zero naming the
+# file and the system's reason.
+set(_ex_writers
+  "bluff_body_drag|--cells|4|--time|2e-4|--quiet"
+  "gresho_vortex|--cells|8|--t-end|0.01|--quiet"
+  "isentropic_vortex|--cells|8|--t-end|0.01|--quiet"
+  "leak_box|--cells|10|--time|1e-4|--quiet"
+  "piston|--cells|20|--time|1e-3|--quiet"
+  "porous_screen|--cells|10|--time|1e-4|--quiet"
+  "shock_tube|--cells|8|--t-end|1e-3|--quiet"
+  "hanging_chain|--links|8|--length|1.2|--span|1"
+  "inflated_membrane|--radius|0.5|--thickness|1e-3|--E|1e7|--nu|0.3|--pressure|100|--elements|2"
+  "tumbling_box|--omega|0.1,2,0.1|--inertia|1,2,3|--t-end|0.01"
+  "fluid_guide|--t-end|1e-3|--h-fine|0.5")
+foreach(entry IN LISTS _ex_writers)
+  string(REPLACE "|" ";" entry "${entry}")
+  list(POP_FRONT entry program)
+  parafsi_example_refuses(example_${program}_out_full ${program} ""
+    "cannot write '/dev/full': No space left on device" ${entry} --out /dev/full)
+  parafsi_example_refuses(example_${program}_out_not_a_directory ${program} ""
+    "cannot open '/dev/full/x\\.csv': Not a directory" ${entry} --out /dev/full/x.csv)
+endforeach()
+parafsi_example_refuses(example_drop_guide_history_full drop_guide "history.csv"
+  "cannot write '[^']*history\\.csv': No space left on device" --t-end 1e-3)
+
+# ---- The two former hangs end at once, naming the flag (the library guards behind them:
+# structure::relax's step limit, tests/test_structure_cable.cpp; examples::step_guard).
+parafsi_example_refuses(example_hanging_chain_huge_EA hanging_chain "" "--EA: Value 1e300 not in range"
+  --links 8 --length 1.2 --span 1 --EA 1e300 --out ${_ex_out}/unused_chain.csv)
+parafsi_example_refuses(example_bluff_body_drag_tiny_reynolds bluff_body_drag ""
+  "--reynolds: Reynolds number 1e-300 is neither 0" --reynolds 1e-300 --out ${_ex_out}/unused_bluff.csv)
+
+# ---- The command-line robustness table: every program × every numeric flag (read from
+# its --help) × {nan, inf, -1, 0, 1e300, 1e-300}: a clean run or a non-zero exit naming
+# the flag, each within 20 s (tests/cli/cli_robustness.py).
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME example_cli_robustness
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/cli/cli_robustness.py
+            --bin $<TARGET_FILE_DIR:parachute_drop> --timeout 20 --jobs 2)
+  set_tests_properties(example_cli_robustness PROPERTIES TIMEOUT 900 LABELS examples)
+endif()

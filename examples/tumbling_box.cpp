@@ -13,6 +13,8 @@
 // constant to round-off, and the energy error stays bounded (no drift).
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include <parafsi/core/error.hpp>
+#include <parafsi/io/checked_file.hpp>
 #include <parafsi/structure/free_top.hpp>
 #include <parafsi/structure/rigid_body.hpp>
 
@@ -84,13 +87,17 @@ int main(int argc, char** argv) {
   app.add_option("--inertia", inertia_text, "principal moments of inertia IX,IY,IZ (kg m^2)")
       ->required()
       ->check(vec3_validator());
-  app.add_option("--t-end", t_end, "simulated time (s)")->required()->check(positive_validator());
+  app.add_option("--t-end", t_end, "simulated time (s)")
+      ->required()
+      ->check(positive_validator())
+      ->check(CLI::Range(1e-9, 1e6));
   app.add_option("--dt", dt, "time step (s); default 1e-3/|omega| (1 mrad per step)")
-      ->check(positive_validator());
+      ->check(positive_validator())
+      ->check(CLI::Range(1e-12, 1e3));
   app.add_option("--every", every, "write every N-th step (default: at most ~20000 rows)")
       ->check(CLI::PositiveNumber);
   app.add_option("--out", out_path, "output CSV file")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
 
   try {
     using parafsi::structure::rigid_body;
@@ -98,18 +105,29 @@ int main(int argc, char** argv) {
     parse_vec3(omega_text, omega0);
     parse_vec3(inertia_text, inertia);
     parafsi::require(omega0.norm() > 0, "--omega: the angular velocity must not be zero");
+    parafsi::require(inertia.minCoeff() > 0 && inertia.maxCoeff() <= 1e12 * inertia.minCoeff(),
+                     "--inertia: the principal moments must be > 0 and within a factor 1e12 of each other, got ",
+                     inertia.x(), ",", inertia.y(), ",", inertia.z());
+    for (int k = 0; k < 3; ++k)
+      parafsi::require(inertia[k] <= inertia[(k + 1) % 3] + inertia[(k + 2) % 3], "--inertia: the principal moments ",
+                       inertia.x(), ",", inertia.y(), ",", inertia.z(), " violate the triangle inequality");
     rigid_body body({1.0, inertia}, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(),
                     Eigen::Vector3d::Zero(), omega0);
-    if (dt == 0) dt = 1e-3 / omega0.norm();
+    const bool dt_from_omega = dt == 0;
+    if (dt_from_omega) dt = 1e-3 / omega0.norm();
     dt = std::min(dt, t_end);
+    // The step count from doubles, checked before the cast.
+    parafsi::require(t_end / dt <= 1e8, "--t-end / --dt: ", t_end, " s at steps of ", dt, " s",
+                     dt_from_omega ? " (the default --dt, 1e-3/|--omega|)" : "", " is ", t_end / dt,
+                     " steps, more than 1e8 (raise --dt or shorten --t-end)");
     const long n_steps = static_cast<long>(std::ceil(t_end / dt - 1e-9));
     if (dt > body.critical_dt())
       std::cerr << "tumbling_box: warning: dt = " << dt << " exceeds the rotational limit critical_dt = "
                 << body.critical_dt() << " s\n";
     if (every == 0) every = std::max(1L, n_steps / 20000);
 
-    std::ofstream csv(out_path);
-    parafsi::require(static_cast<bool>(csv), "--out: cannot open '", out_path, "' for writing");
+    parafsi::io::checked_file csv_file(out_path);  // opened now: a bad --out fails before the run
+    std::ostringstream csv;
     csv.precision(17);
     csv << "t,wx,wy,wz,energy,angular_momentum\n";
 
@@ -152,7 +170,8 @@ int main(int argc, char** argv) {
         last_report = now;
       }
     }
-    parafsi::require(static_cast<bool>(csv), "--out: writing '", out_path, "' failed");
+    csv_file.write(csv.str());
+    csv_file.close();
 
     const double T_exact = parafsi::structure::free_top_period(inertia, omega0);
     std::cout.precision(10);

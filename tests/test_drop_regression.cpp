@@ -79,8 +79,9 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   c.checkpoint_every = 0.06;
   const auto full = parafsi::scene::run_drop(c);
 
+  // Into another directory, without the first run's history.csv: the checkpoint carries
+  // the rows up to its time, so the history and summary cover the whole run.
   fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
-  fs::copy_file(base / "a" / "history.csv", base / "b" / "history.csv");
   c.out = (base / "b").string();
   c.checkpoint_every = 0;
   c.restart = (base / "b" / "checkpoint.ckpt").string();
@@ -113,36 +114,118 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
     c.quiet = true;
     c.out = (base / "a").string();
     c.restart = (base / "a" / "checkpoint.ckpt").string();  // written by the embedded, alpha = 8 run
-    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("restart with the --pgs and scene"),
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c),
+                         doctest::Contains("scene parameter 'pgs_alpha' is 8 in the file but 1 here"),
                          parafsi::invalid_input);
     // The same scene, but t_end (0.05 s) before the checkpoint's time (0.06 s): nothing to run.
     c.pgs_alpha = 0.0;
     c.t_end = 0.05;
     CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("is not after the time of checkpoint"),
                          parafsi::invalid_input);
-    // A bad number in the history read back on the restart is named with its file, line
-    // and column (line 3 is the row of t = 0.005 s; column 4 is z).
-    fs::remove_all(base / "b");
-    fs::create_directories(base / "b");
-    {
-      std::ifstream in(base / "a" / "history.csv");
-      std::ofstream os(base / "b" / "history.csv");
-      std::string line;
-      for (int n = 1; std::getline(in, line); ++n) {
-        if (n == 3) {
-          std::size_t p = 0;
-          for (int k = 0; k < 3; ++k) p = line.find(',', p) + 1;
-          line.insert(p, "x");
-        }
-        os << line << '\n';
-      }
-    }
-    c.t_end = 0.1;
-    c.out = (base / "b").string();
-    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("history.csv' line 3, column 4 (z): 'x"),
+    c.t_end = 0.06;
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains("is not after the time of checkpoint"),
                          parafsi::invalid_input);
   }
   fs::remove_all(base);
+}
+
+// A restart refuses every parameter that changes the run (scene::drop_signature), naming
+// it: one checkpoint at 0.01 s of a tiny run, then a restart per changed parameter.
+TEST_CASE("drop restart: a changed scene parameter is refused by name") {
+  namespace fs = std::filesystem;
+  parafsi::parallel::set_threads(1);
+  const fs::path base = fs::temp_directory_path() / "parafsi_drop_signature";
+  fs::remove_all(base);
+  parafsi::scene::drop_config c0;
+  c0.resolution = "tiny";
+  c0.t_end = 0.01;
+  c0.initial_speed = 8.0;
+  c0.quiet = true;
+  c0.out = base.string();
+  c0.checkpoint_every = 0.01;
+  parafsi::scene::run_drop(c0);
+  REQUIRE(fs::exists(base / "checkpoint.ckpt"));
+  c0.out.clear();
+  c0.checkpoint_every = 0;
+  c0.restart = (base / "checkpoint.ckpt").string();
+  c0.t_end = 0.02;
+  using cfg = parafsi::scene::drop_config;
+  struct change {
+    const char* name;
+    void (*apply)(cfg&);
+  };
+  const change changes[] = {
+      {"canopy", [](cfg& c) { c.canopy = "c9"; }},
+      {"fabric", [](cfg& c) { c.fabric = "mat509"; }},
+      {"cell", [](cfg& c) { c.cell = 0.3; }},
+      {"element", [](cfg& c) { c.element = 0.15; }},
+      {"growth", [](cfg& c) { c.growth = 1.5; }},
+      {"coupling", [](cfg& c) { c.coupling = "penalty"; }},
+      {"pgs_alpha", [](cfg& c) { c.pgs_alpha = 6; }},
+      {"impedance", [](cfg& c) { c.impedance = 0.5; }},
+      {"pfac", [](cfg& c) { c.pfac = 2; }},
+      {"stiffening", [](cfg& c) { c.stiffening = 0.5; }},
+      {"coupling_damping", [](cfg& c) { c.coupling_damping = 0.1; }},
+      {"viscosity", [](cfg& c) { c.viscosity = "constant"; }},
+      {"cfl", [](cfg& c) { c.cfl = 0.5; }},
+      {"membrane_damping", [](cfg& c) { c.membrane_damping = 0.1; }},
+      {"history_every", [](cfg& c) { c.history_every = 0.004; }},
+      {"initial_speed", [](cfg& c) { c.initial_speed = 9; }},
+      {"payload_mass", [](cfg& c) { c.payload_mass = 50; }},
+      {"line_stiffness", [](cfg& c) { c.line_stiffness = 10; }},
+      {"modulus_scale", [](cfg& c) { c.modulus_scale = 10; }},
+      {"packed", [](cfg& c) { c.packed = "constructed"; }},
+      {"packed_parameter", [](cfg& c) { c.packed_parameter = 0.3; }},
+      {"box", [](cfg& c) {
+         c.box = "fixed";
+         c.fixed_fall = 5;
+       }},
+      {"box_width", [](cfg& c) { c.box_width = 6; }},
+      {"box_length", [](cfg& c) { c.box_length = 8; }},
+      {"box_ahead", [](cfg& c) { c.box_ahead = 2; }},
+  };
+  for (const change& ch : changes) {
+    CAPTURE(ch.name);
+    cfg c = c0;
+    ch.apply(c);
+    const std::string expected = std::string("scene parameter '") + ch.name + "' is ";
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected.c_str()), parafsi::invalid_input);
+  }
+  // The same scene restarts (t_end, out and the output intervals are not part of it).
+  cfg same = c0;
+  same.t_end = 0.015;
+  const auto r = parafsi::scene::run_drop(same);
+  CHECK(r.history.size() == 4);  // 0, 0.005, 0.01 carried; 0.015
+  CHECK(r.history[2].t == doctest::Approx(0.01).epsilon(1e-12));
+  fs::remove_all(base);
+}
+
+// Settings that would be dropped silently are refused before anything is built, naming
+// the flag: output intervals without an output directory, a reduced radius of 0, slice
+// times that are not output instants or not in order.
+TEST_CASE("drop config: silently dropped settings are refused by name") {
+  using cfg = parafsi::scene::drop_config;
+  auto refused = [](cfg c, const char* expected) {
+    c.resolution = "tiny";
+    c.quiet = true;
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected), parafsi::invalid_input);
+  };
+  cfg c;
+  c.out.clear();
+  c.checkpoint_every = 0.1;
+  refused(c, "need an output directory, but --out is empty");
+  c.checkpoint_every = 0;
+  c.vtk_every = 0.1;
+  refused(c, "--vtk-every 0.1");
+  c = cfg{};
+  c.packed = "reduced_radius";
+  c.packed_parameter = 0;
+  refused(c, "--packed-parameter 0: the reduced radius s of the packed canopy must be in (0, 1]");
+  c = cfg{};
+  c.slice_times = {0.0123};
+  refused(c, "--slice-times 0.0123 s is not an output instant (a multiple of --history-every");
+  c.slice_times = {0.2, 0.1};
+  refused(c, "--slice-times must be in increasing order");
 }
 
 // Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the

@@ -84,6 +84,14 @@ TEST_CASE("csv_writer: flush policies") {
   CHECK(lines_of(p).size() == 5);
 }
 
+// A full disk (/dev/full accepts the open, fails every write) is an error naming the
+// file, at the first flushed row, not a silent success.
+TEST_CASE("csv_writer: a failed write throws naming the file") {
+  if (!fs::exists("/dev/full")) return;
+  CHECK_THROWS_WITH_AS(io::csv_writer("/dev/full", {"t"}).row({1.0}),
+                       doctest::Contains("write to /dev/full failed"), invalid_input);
+}
+
 TEST_CASE("progress: rate-limited lines with steps/s, ETA and extra fields") {
   double wall = 100.0;
   std::ostringstream os;

@@ -245,6 +245,22 @@ TEST_CASE("vtu: well-formed XML, point/cell counts, stresses and tensions round-
                        invalid_input);
 }
 
+// A VTK file that cannot be written is an error naming the file and the system's reason:
+// the temporary file linked to /dev/full (every write fails with ENOSPC).
+TEST_CASE("vtu: a failed write throws io::write_error naming the file") {
+  if (!fs::exists("/dev/full")) return;
+  auto a = small_assembly();
+  const fs::path p = scratch("full.vtu");
+  fs::path tmp = p;
+  tmp += ".tmp";
+  fs::remove(tmp);
+  fs::create_symlink("/dev/full", tmp);
+  CHECK_THROWS_WITH_AS(io::write_vtu(p, a), doctest::Contains("full.vtu.tmp': No space left on device"),
+                       io::write_error);
+  fs::remove(tmp);
+  CHECK_FALSE(fs::exists(p));
+}
+
 TEST_CASE("vts: inertial corner points on a turned box, cell values round-trip, vorticity of solid rotation = 2 Omega") {
   const auto grid = fluid::rectilinear_grid(fluid::axis::refined(-1.0, 1.0, -0.3, 0.3, 0.1, 1.2),
                                             fluid::axis::uniform(6, -0.6, 0.6), fluid::axis::uniform(5, 0.0, 1.0));

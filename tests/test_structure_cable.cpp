@@ -126,6 +126,37 @@ TEST_CASE("hanging chain matches the catenary within 1 % of the span") {
   CHECK(dev / S < 0.01);
 }
 
+// relax() never hangs: a chain with EA = 1e300 N has a stable step of ~1e-151 s, so
+// reaching t_max = 60 s would take ~1e152 steps; refused before the first step, naming
+// the step count. A step limit stops a run that would take longer than max_steps.
+TEST_CASE("relax refuses a run whose stable step makes t_max unreachable, and stops at max_steps") {
+  auto chain = [](double EA) {
+    const int N = 8;
+    st::nodes nd;
+    for (int i = 0; i <= N; ++i) {
+      const double s = double(i) / N;
+      nd.add({-0.5 + s, 0.0, -0.66 * std::min(s, 1 - s)});
+    }
+    nd.pin(0);
+    nd.pin(N);
+    st::line_mesh lm;
+    for (int i = 0; i < N; ++i) { lm.segments.push_back({i, i + 1}); lm.rest_length.push_back(1.2 / N); }
+    return st::assembly{std::move(nd), st::cable{lm, st::material::cable{EA, 0.1, 0.2, 0.0}}};
+  };
+  auto stiff = chain(1e300);
+  st::relax_options ro;
+  ro.t_max = 60.0;
+  CHECK_THROWS_WITH_AS(st::relax(stiff, ro), doctest::Contains("steps, more than max_steps = 1000000000"),
+                       parafsi::numerical_failure);
+  CHECK(stiff.time() == 0.0);  // refused before any step
+  auto soft = chain(1e4);
+  ro.max_steps = 50;
+  ro.t_min = 1.0;
+  ro.t_max = 1e30;  // unbounded time: the step limit alone ends it
+  CHECK_THROWS_WITH_AS(st::relax(soft, ro), doctest::Contains("not at rest after max_steps = 50 steps"),
+                       parafsi::numerical_failure);
+}
+
 TEST_CASE("steel wire lines on a light fabric run stably with the computed substep count") {
   auto make = [] {
     const auto d = parafsi::model::disk_mesh(0.5, 6);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -183,6 +184,30 @@ TEST_CASE("sliver triangles are rejected at set-up with their id") {
   INFO(msg);
   CHECK(msg.find("element 1") != std::string::npos);
   CHECK(msg.find("sliver") != std::string::npos);
+}
+
+TEST_CASE("a non-finite reference position or warp direction is refused at set-up, not called a sliver") {
+  auto finalize_message = [](Eigen::Vector3d x2, Eigen::Vector3d warp) {
+    st::nodes nd;
+    nd.add({0, 0, 0}); nd.add({1, 0, 0}); nd.add({0, 1, 0});
+    st::triangle_mesh m;
+    m.triangles = {{0, 1, 2}};
+    m.reference = {{0, 0, 0}, {1, 0, 0}, x2};  // the stress-free state
+    m.warp = warp;
+    st::assembly s{std::move(nd), st::membrane_tri{m, st::material::fabric<>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
+    std::string msg;
+    try { s.finalize(); } catch (const parafsi::invalid_input& e) { msg = e.what(); }
+    return msg;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::string a = finalize_message({0, nan, 0}, Eigen::Vector3d::UnitX());
+  INFO(a);
+  CHECK(a.find("element 0 has a non-finite reference position at node 2") != std::string::npos);
+  CHECK(a.find("sliver") == std::string::npos);
+  const std::string b = finalize_message({0, 1, 0}, {nan, 0, 0});
+  INFO(b);
+  CHECK(b.find("element 0 has a non-finite warp direction") != std::string::npos);
+  CHECK(finalize_message({0, 1, 0}, Eigen::Vector3d::UnitX()).empty());  // the valid element passes
 }
 
 TEST_CASE("membrane_tri: SIMD and scalar kernels agree; results do not depend on thread count") {

@@ -10,11 +10,12 @@
 ///   explicit_stepper s2{same scene};  io::scene_signature scene2{same parameters};
 ///   io::load_checkpoint("out/run.ckpt", s2, scene2);          // then continue stepping
 ///
-/// Arguments are fluid solvers, structure assemblies, explicit_steppers and at most one
-/// io::scene_signature. The k-th solver goes to the section "fluid" (k = 0) or
-/// "fluid.k", the k-th assembly to "structure"/"structure.k"; a stepper writes its fluid
-/// and its structure there and its own clock and coupling to "stepper"; a scene
-/// signature to "scene". Loading reads the sections its arguments need and ignores the
+/// Arguments are fluid solvers, structure assemblies, explicit_steppers, at most one
+/// io::scene_signature and components that name their own section (a static
+/// `checkpoint_section`, e.g. io::drop_history_record: section "history").
+/// The k-th solver goes to the section "fluid" (k = 0) or "fluid.k", the k-th assembly
+/// to "structure"/"structure.k"; a stepper writes its fluid and its structure there and
+/// its own clock and coupling to "stepper"; a scene signature to "scene". Loading reads the sections its arguments need and ignores the
 /// others (a stepper's fluid and assembly may also be loaded on their own, and a stepper
 /// built from them afterwards: its clock then starts at the fluid's time and its first
 /// coupling kick uses its first substep).
@@ -155,6 +156,11 @@ concept coupled_stepper = requires(const T& s) {
   s.last_substeps();
 };
 
+/// A component that names its own section (`static constexpr const char* checkpoint_section`),
+/// e.g. io::drop_history_record: the program's records beside the physical state.
+template <class T>
+concept named_section = requires { T::checkpoint_section; };
+
 inline std::string fluid_section(int k) { return k == 0 ? std::string("fluid") : "fluid." + std::to_string(k); }
 inline std::string structure_section(int k) {
   return k == 0 ? std::string("structure") : "structure." + std::to_string(k);
@@ -174,6 +180,8 @@ void for_each_section(F&& f, Parts&... parts) {
       f(fluid_section(nf++), p);
     } else if constexpr (structure_assembly<P>) {
       f(structure_section(ns++), p);
+    } else if constexpr (named_section<P>) {
+      f(std::string(P::checkpoint_section), p);
     } else if constexpr (std::is_same_v<P, scene_signature>) {
       require(nscene++ == 0, "io::checkpoint: give at most one scene_signature");
       f(std::string("scene"), p);

@@ -9,7 +9,8 @@
 /// round-trip exactly), '.' as decimal point whatever the locale, "nan"/"inf" for
 /// non-finite values. A row with the wrong number of values is an error naming both
 /// counts. Flush policy: every row (default), every n rows, or at most every
-/// `interval` wall seconds; the destructor and `flush()` always flush.
+/// `interval` wall seconds; the destructor, `flush()` and `close()` always flush, and every
+/// write, flush and `close()` is checked (a full disk throws naming the file).
 /// Restart: `csv_options::resume_after = t` opens an existing file with the same header,
 /// keeps the rows whose first column is <= t (the rows up to the checkpoint) and
 /// appends after them; a header that differs is an error naming both.
@@ -131,11 +132,20 @@ class csv_writer {
         break;
       case flush_policy::on_close: break;
     }
+    require(out_.good(), "io::csv_writer: write to ", path_.string(), " failed (disk full?)");
   }
   void row(std::initializer_list<double> values) { row(std::span<const double>(values.begin(), values.size())); }
   void flush() {
     out_.flush();
+    require(out_.good(), "io::csv_writer: write to ", path_.string(), " failed (disk full?)");
     last_flush_ = now();
+  }
+  /// Flush and close, checked: the file is complete only if this returns (the destructor
+  /// flushes without reporting).
+  void close() {
+    flush();
+    out_.close();
+    require(!out_.fail(), "io::csv_writer: closing ", path_.string(), " failed");
   }
 
  private:

@@ -145,14 +145,11 @@ inline void write_drop_summary(const std::filesystem::path& path, const drop_sum
   write_text_file(path, std::string(drop_summary_header) + '\n' + s.csv_row() + '\n');
 }
 
-/// The rows of the history file `path` with t <= t_max, in file order (rules in the file
-/// comment); no file: no rows.
-inline std::vector<drop_history_row> read_drop_history(const std::filesystem::path& path, double t_max) {
+/// The rows of history text `text` (history.csv's format; `source` names it in messages)
+/// with t <= t_max, in order (rules in the file comment).
+inline std::vector<drop_history_row> parse_drop_history(std::string_view text, const std::string& source,
+                                                        double t_max) {
   std::vector<drop_history_row> rows;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return rows;
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  require(!in.bad(), "io::read_drop_history: cannot read '", path.string(), "'");
   static constexpr std::array<const char*, drop_history_row::columns> names{
       "t", "x", "y", "z", "vx", "vy", "vz", "speed", "canopy_diameter", "open_force", "payload_phi_x",
       "payload_phi_y", "canopy_phi_x", "canopy_phi_y", "flight_path_angle", "drag_coefficient"};
@@ -166,7 +163,7 @@ inline std::vector<drop_history_row> read_drop_history(const std::filesystem::pa
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_no == 1) {
-      require(line == drop_history_header, "io::read_drop_history: '", path.string(), "' line 1: header '", line,
+      require(line == drop_history_header, "io::read_drop_history: '", source, "' line 1: header '", line,
               "' is not the drop history's ('", drop_history_header, "')");
       continue;
     }
@@ -176,22 +173,53 @@ inline std::vector<drop_history_row> read_drop_history(const std::filesystem::pa
     while (true) {
       const std::size_t comma = line.find(',', start);
       const std::string_view item = line.substr(start, comma == std::string_view::npos ? line.npos : comma - start);
-      require(k < v.size(), "io::read_drop_history: '", path.string(), "' line ", line_no, ": more than ",
-              v.size(), " columns");
+      require(k < v.size(), "io::read_drop_history: '", source, "' line ", line_no, ": more than ", v.size(),
+              " columns");
       double x = 0;
       const auto res = std::from_chars(item.data(), item.data() + item.size(), x);
       require(!item.empty() && res.ec == std::errc{} && res.ptr == item.data() + item.size(),
-              "io::read_drop_history: '", path.string(), "' line ", line_no, ", column ", k + 1, " (", names[k],
-              "): '", item, "' is not a number");
+              "io::read_drop_history: '", source, "' line ", line_no, ", column ", k + 1, " (", names[k], "): '",
+              item, "' is not a number");
       v[k++] = x;
       if (comma == std::string_view::npos) break;
       start = comma + 1;
     }
-    require(k == v.size(), "io::read_drop_history: '", path.string(), "' line ", line_no, ": ", k,
-            " columns, expected ", v.size());
+    require(k == v.size(), "io::read_drop_history: '", source, "' line ", line_no, ": ", k, " columns, expected ",
+            v.size());
     if (v[0] <= t_max) rows.push_back(drop_history_row::from(v));
   }
   return rows;
 }
+
+/// The rows of the history file `path` with t <= t_max, in file order (rules in the file
+/// comment); no file: no rows.
+inline std::vector<drop_history_row> read_drop_history(const std::filesystem::path& path, double t_max) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  require(!in.bad(), "io::read_drop_history: cannot read '", path.string(), "'");
+  return parse_drop_history(text, path.string(), t_max);
+}
+
+/// The history rows of a run up to a checkpoint, stored in the checkpoint's section
+/// "history" (history.csv's text, exact: shortest round-trip numbers), so a restart into
+/// another directory carries them and its summary covers the whole run.
+///   io::drop_history_record rec{rows};  io::save_checkpoint(path, sig, stepper, rec);
+struct drop_history_record {
+  static constexpr const char* checkpoint_section = "history";
+  std::vector<drop_history_row> rows;
+
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    std::string text;
+    if constexpr (Archive::saving) {
+      text = std::string(drop_history_header) + '\n';
+      for (const auto& r : self.rows) append_history_row(text, r);
+    }
+    ar("rows", text);
+    if constexpr (Archive::loading)
+      self.rows = parse_drop_history(text, "checkpoint section 'history'", std::numeric_limits<double>::infinity());
+  }
+};
 
 }  // namespace parafsi::io

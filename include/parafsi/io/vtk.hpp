@@ -70,6 +70,7 @@
 
 #include "../core/config.hpp"
 #include "../core/error.hpp"
+#include "checked_file.hpp"
 
 namespace parafsi::io {
 
@@ -180,18 +181,12 @@ inline std::string time_field_data(double t, xml_out& x) {
   return "    <FieldData>\n" + x.s + "    </FieldData>\n";
 }
 
-/// Write `text` to `path` through `path.tmp` + rename.
+/// Write `text` to `path` through `path.tmp` (a checked file) + rename.
 inline void write_file_atomic(const std::filesystem::path& path, const std::string& text) {
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::filesystem::path tmp = path;
   tmp += ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    require(out.good(), "io: cannot open ", tmp.string(), " for writing");
-    out.write(text.data(), std::streamsize(text.size()));
-    out.flush();
-    require(out.good(), "io: writing ", tmp.string(), " failed (disk full?)");
-  }
+  write_text_file(tmp, text);  // checked open, write and close (io::write_error naming the file)
   std::filesystem::rename(tmp, path);
 }
 

@@ -39,7 +39,9 @@
 /// or when the payload leaves a fixed box's refined column. Restart: the stepper's state
 /// from the checkpoint (refused if its air is not at this run's ambient, i.e. another α or
 /// scene pressure, or if t_end is not after its time), the history rows up to the
-/// restored time from <out>/history.csv.
+/// restored time from the checkpoint (its section "history"). A checkpoint holds the
+/// run's drop_signature: a restart whose parameters differ is refused naming the
+/// parameter and both values.
 /// Messages (progress is the caller's, through `progress`) go to stderr unless `quiet`.
 #pragma once
 #include <algorithm>
@@ -144,11 +146,27 @@ struct drop_config {
             "resolution's), got ", growth);
     require(cell >= 0 && element >= 0, "parachute_drop: cell and element sizes must be >= 0 (0: the resolution's), "
             "got ", cell, " and ", element);
+    // Penalty stiffening multiplies the springs by 1 + (d/(λh))², which the stable step does
+    // not see: a tiny λ diverges.
+    require(stiffening == 0 || (stiffening >= 0.01 && stiffening <= 10),
+            "parachute_drop: --stiffening must be 0 (off) or in [0.01, 10], got ", stiffening);
     require(line_stiffness > 0, "parachute_drop: line stiffness scale must be > 0, got ", line_stiffness);
     require(modulus_scale > 0, "parachute_drop: fabric modulus scale must be > 0, got ", modulus_scale);
-    require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: PGS alpha must be >= 1 (0: auto), got ", pgs_alpha);
+    require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: --pgs (PGS alpha) must be >= 1 (0: auto), got ", pgs_alpha);
     require(vtk_every >= 0 && checkpoint_every >= 0, "parachute_drop: VTK and checkpoint intervals must be >= 0 s, "
             "got ", vtk_every, " and ", checkpoint_every);
+    require(!out.empty() || (vtk_every == 0 && checkpoint_every == 0),
+            "parachute_drop: --vtk-every ", vtk_every, " and --checkpoint-every ", checkpoint_every,
+            " need an output directory, but --out is empty (no files)");
+    require(packed != "reduced_radius" || packed_parameter < 0 || (packed_parameter > 0 && packed_parameter <= 1),
+            "parachute_drop: --packed-parameter ", packed_parameter,
+            ": the reduced radius s of the packed canopy must be in (0, 1] (negative: the default 0.2)");
+    require(std::is_sorted(slice_times.begin(), slice_times.end()),
+            "parachute_drop: --slice-times must be in increasing order");
+    for (double t : slice_times)  // a slice is written at an output instant and labelled with its time
+      require(std::fabs(std::round(t / history_every) * history_every - t) <= 1e-9 * std::max(t, history_every),
+              "parachute_drop: --slice-times ", t, " s is not an output instant (a multiple of --history-every ",
+              history_every, " s)");
     require(box != "fixed" || fixed_fall > 0,
             "parachute_drop: a fixed box needs the fall length it must hold (> 0 m), got ", fixed_fall);
   }
@@ -203,7 +221,13 @@ inline drop_setup make_drop_setup(const drop_config& c) {
     P.shape = model::packed_shape::constructed();
   su.fixed_box = c.box == "fixed";
   P.canopy.element_size = R.element * D0;
-  su.scene = model::build_drop_scene(P);
+  // The model's refusals name counts and sizes; the flags that set them are added here.
+  try {
+    su.scene = model::build_drop_scene(P);
+  } catch (const invalid_input& e) {
+    throw invalid_input(parafsi::detail::concat("parachute_drop: the scene (--element ", R.element, " D0, --packed ",
+                                                c.packed, "): ", e.what()));
+  }
   model::drop_box_parameters bp;
   bp.width = c.box_width;
   bp.length = c.box_length;
@@ -211,13 +235,41 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   bp.cell = R.cell;
   bp.growth = R.growth;
   bp.fall = su.fixed_box ? c.fixed_fall : 0.0;
-  su.box = model::make_drop_box(su.scene, bp);
+  try {
+    su.box = model::make_drop_box(su.scene, bp);
+  } catch (const invalid_input& e) {
+    throw invalid_input(parafsi::detail::concat("parachute_drop: the fluid box (--cell ", R.cell, " D0, --growth ",
+                                                R.growth, ", --box-width ", c.box_width, ", --box-length ",
+                                                c.box_length, "): ", e.what()));
+  }
   // α = 0: auto, 8 for the embedded coupling (docs/validation.md §8), 1 for penalty (its
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
   const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
   su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
+}
+
+/// Every parameter of `c` (resolved by `su`) that changes the run: saved with each
+/// checkpoint and compared on restart (io::scene_signature), so a restart with another
+/// scene, resolution, coupling, α, payload, moduli, packed shape, box, closure, CFL,
+/// damping or output interval is refused naming the parameter and both values. Not in it:
+/// t_end, out, slice_times, vtk_every, checkpoint_every, threads (they do not change the
+/// computed states).
+inline io::scene_signature drop_signature(const drop_config& c, const drop_setup& su) {
+  io::scene_signature g;
+  g.add("canopy", c.canopy).add("fabric", std::string(su.scene.fabric.name)).add("resolution", c.resolution);
+  g.add("cell", su.resolution.cell).add("element", su.resolution.element).add("growth", su.resolution.growth);
+  g.add("coupling", c.coupling).add("pgs_alpha", su.alpha).add("impedance", c.impedance);
+  g.add("pfac", c.pfac).add("stiffening", c.stiffening).add("coupling_damping", c.coupling_damping);
+  g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
+  g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
+  g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
+  g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
+  g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
+  g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
+  g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
+  return g;
 }
 
 namespace detail {
@@ -237,13 +289,15 @@ class drop_run {
         pgs_{su.alpha},
         p_offset_(pgs_.pressure_offset(su.params.air_pressure)),
         c_air_(gas::ideal{}.sound_speed(su.params.air_density, su.params.air_pressure)),
-        files_(!c.out.empty()) {}
+        files_(!c.out.empty()),
+        signature_(drop_signature(c, su)) {}
   drop_run(const drop_run&) = delete;
   drop_run& operator=(const drop_run&) = delete;
 
   drop_result run(const drop_progress& progress) {
     drop_result res;
     const auto& nd = s_.structure().node_set();
+    history_ = &res.history;
     if (!c_.restart.empty()) res.history = restart();
     open_outputs(res.history);
     const auto& g = s_.fluid().grid();
@@ -307,23 +361,28 @@ class drop_run {
  private:
   std::filesystem::path out() const { return std::filesystem::path(c_.out); }
 
-  /// The stepper's state from the checkpoint; the history rows up to its time.
+  /// The stepper's state from the checkpoint (its scene signature compared first); the
+  /// history rows up to its time, from the checkpoint.
   std::vector<io::drop_history_row> restart() {
-    io::load_checkpoint(c_.restart, s_);
+    io::scene_signature sig = signature_;
+    io::drop_history_record previous;
+    io::load_checkpoint(c_.restart, sig, s_, previous);
     // The checkpoint holds the fluid, not the far field: a run restarted with another α
-    // (or scene pressure) would put the restored air against a different ambient.
+    // (or scene pressure) would put the restored air against a different ambient (the
+    // signature names α; this guards a scene pressure that is not in it).
     const double q = s_.fluid().primitive(0, 0, 0).p, q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
     require(q > 0.5 * q_inf && q < 2.0 * q_inf, "parachute_drop: checkpoint '", c_.restart, "' holds air at ", q,
             " Pa in a corner cell, but this run's ambient is ", q_inf, " Pa (PGS alpha ", su_.alpha,
             "): restart with the --pgs and scene of the run that wrote it");
     require(c_.t_end > s_.time() + 1e-12, "parachute_drop: t_end ", c_.t_end,
             " s is not after the time of checkpoint '", c_.restart, "', ", s_.time(), " s: nothing to run");
-    std::vector<io::drop_history_row> previous;
-    if (files_) previous = io::read_drop_history(out() / "history.csv", s_.time() + 1e-12);
+    require(!previous.rows.empty() && previous.rows.back().t <= s_.time() + 1e-12,
+            "parachute_drop: checkpoint '", c_.restart, "' holds ", previous.rows.size(),
+            " history rows, the last not at or before its time ", s_.time(), " s");
     if (!c_.quiet)
-      std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows kept)\n",
-                   c_.restart.c_str(), s_.time(), previous.size());
-    return previous;
+      std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows carried)\n",
+                   c_.restart.c_str(), s_.time(), previous.rows.size());
+    return std::move(previous.rows);
   }
 
   /// history.csv with the rows carried over; the VTK series.
@@ -369,7 +428,7 @@ class drop_run {
       next_vtk_ += c_.vtk_every;
     }
     if (files_ && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every) {
-      io::save_checkpoint(c_.out + "/checkpoint.ckpt", s_);
+      io::save_checkpoint(c_.out + "/checkpoint.ckpt", signature_, s_, io::drop_history_record{*history_});
       next_ckpt_ += c_.checkpoint_every;
     }
   }
@@ -415,6 +474,8 @@ class drop_run {
   std::optional<io::pvd_writer> pvd_;
   double next_vtk_ = 0, next_ckpt_ = 0;
   bool warned_mach_ = false;
+  io::scene_signature signature_;
+  const std::vector<io::drop_history_row>* history_ = nullptr;  ///< the rows so far, saved with a checkpoint
 };
 
 /// f(viscosity, frame) for the setup's choices (resolved once: everything below is

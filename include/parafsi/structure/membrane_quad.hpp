@@ -183,6 +183,7 @@ class membrane_quad {
                   qd[std::size_t(a)], " (a collapsed quad; use a triangle)");
       std::array<Eigen::Vector3d, 4> X;
       for (int a = 0; a < 4; ++a) X[std::size_t(a)] = mesh_.reference[std::size_t(qd[std::size_t(a)])];
+      impl::check_reference_finite<4>(name(), e, X, {qd[0], qd[1], qd[2], qd[3]});
       const Eigen::Vector3d n0 = (X[2] - X[0]).cross(X[3] - X[1]);
       const double A2 = n0.norm();
       double lmax = 0;
@@ -193,7 +194,7 @@ class membrane_quad {
       const Eigen::Vector3d Xc = 0.25 * (X[0] + X[1] + X[2] + X[3]);
       double xh[4], yh[4], zh[4];
       // Warp normal to the element: fall back to edge 0→1 projected on it.
-      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(mesh_, e), (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn);
+      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(name(), mesh_, e), (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn);
       for (int a = 0; a < 4; ++a) {
         xh[a] = (X[std::size_t(a)] - Xc).dot(E1);
         yh[a] = (X[std::size_t(a)] - Xc).dot(E2);

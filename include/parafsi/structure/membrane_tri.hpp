@@ -116,6 +116,7 @@ class membrane_tri {
       impl::check_element_nodes(name(), e, t, N);
       require(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "membrane_tri: element ", e, " repeats a node");
       const Eigen::Vector3d X0 = X(t[0]), X1 = X(t[1]), X2 = X(t[2]);
+      impl::check_reference_finite<3>(name(), e, {X0, X1, X2}, {t[0], t[1], t[2]});
       const Eigen::Vector3d nrm = (X1 - X0).cross(X2 - X0);
       const double A2 = nrm.norm();
       const double l2 = (X1 - X0).squaredNorm() + (X2 - X1).squaredNorm() + (X0 - X2).squaredNorm();
@@ -124,7 +125,7 @@ class membrane_tri {
               t[2], ") is a sliver: quality 4*sqrt(3)*A/sum(l^2) = ", quality, " < min_quality ", opt_.min_quality);
       const Eigen::Vector3d Nn = nrm / A2;
       // Warp normal to the element: fall back to edge 0→1.
-      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(mesh_, e), X1 - X0);
+      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(name(), mesh_, e), X1 - X0);
       const std::array<Eigen::Vector3d, 3> Xs{X0, X1, X2};
       double xh[3], yh[3];
       for (int a = 0; a < 3; ++a) {

@@ -47,10 +47,23 @@ inline void check_warp_count(const char* part, std::size_t n_warp, std::size_t n
           elements);
 }
 
-/// Warp direction of element e of a mesh (per element, or the mesh's common one).
+/// Warp direction of element e of a mesh (per element, or the mesh's common one),
+/// refused if not finite (`part`: the element part's name).
 template <class Mesh>
-Eigen::Vector3d warp_of(const Mesh& mesh, index_t e) {
-  return mesh.warp_per_element.empty() ? mesh.warp : mesh.warp_per_element[std::size_t(e)];
+Eigen::Vector3d warp_of(const char* part, const Mesh& mesh, index_t e) {
+  const Eigen::Vector3d w = mesh.warp_per_element.empty() ? mesh.warp : mesh.warp_per_element[std::size_t(e)];
+  require(w.allFinite(), part, ": element ", e, " has a non-finite warp direction (", w.x(), ", ", w.y(), ", ", w.z(),
+          ")");
+  return w;
+}
+
+/// The reference positions of an element's nodes must be finite (a NaN is not a sliver).
+template <std::size_t K>
+void check_reference_finite(const char* part, index_t e, const std::array<Eigen::Vector3d, K>& X,
+                            const std::array<index_t, K>& nodes_of) {
+  for (std::size_t a = 0; a < K; ++a)
+    require(X[a].allFinite(), part, ": element ", e, " has a non-finite reference position at node ", nodes_of[a],
+            " (", X[a].x(), ", ", X[a].y(), ", ", X[a].z(), ")");
 }
 
 /// Without a given reference, the node positions at the first finalize become the

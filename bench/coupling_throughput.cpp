@@ -99,12 +99,22 @@ int main(int argc, char** argv) {
   setup su;
   std::vector<int> threads{1, 2};
   std::vector<std::string> methods{"penalty", "embedded"};
-  app.add_option("--cells", su.cells, "fluid cells per side of the periodic unit box")->check(CLI::Range(8, 512))->capture_default_str();
-  app.add_option("--rings", su.rings, "disk mesh rings (6 rings^2 triangles, radius 0.35 m)")->check(CLI::Range(2, 1000))->capture_default_str();
+  app.add_option("--cells", su.cells, "fluid cells per side of the periodic unit box")
+      ->check(CLI::Range(8, 512))
+      ->capture_default_str();
+  app.add_option("--rings", su.rings, "disk mesh rings (6 rings^2 triangles, radius 0.35 m)")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
   app.add_option("--steps", su.steps, "timed steps per repeat")->check(CLI::Range(1, 100000))->capture_default_str();
   app.add_option("--repeats", su.repeats, "repeats (median)")->check(CLI::Range(1, 1000))->capture_default_str();
-  app.add_option("--threads", threads, "thread counts")->check(CLI::Range(1, 1024))->delimiter(',')->capture_default_str();
-  app.add_option("--method", methods, "couplings to measure")->check(CLI::IsMember({"penalty", "embedded"}))->delimiter(',')->capture_default_str();
+  app.add_option("--threads", threads, "thread counts")
+      ->check(CLI::Range(1, 1024))
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--method", methods, "couplings to measure")
+      ->check(CLI::IsMember({"penalty", "embedded"}))
+      ->delimiter(',')
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   std::printf("# command: coupling_throughput --cells %d --rings %d --steps %d --repeats %d (OpenMP %s)\n", su.cells,
               su.rings, su.steps, su.repeats, pf::parallel::enabled() ? "on" : "off");
@@ -117,17 +127,19 @@ int main(int argc, char** argv) {
     for (const auto& m : methods) {
       auto report = [&](const result& r, double exch, double str, double flu) {
         const double cost = r.per_step - r0.per_step;
-        std::printf("coupling_throughput method=%s points=%ld threads=%d point_updates_per_s=%.4e share=%.3f "
-                    "coupled_step_s=%.4e uncoupled_step_s=%.4e updates_per_step=%.0f substeps=%ld "
-                    "phase_exchange=%.3f phase_structure=%.3f phase_fluid=%.3f\n",
-                    m.c_str(), long(r.points), t, cost > 0 ? r.updates / cost : 0.0, cost / r.per_step, r.per_step,
-                    r0.per_step, r.updates, r.substeps, exch, str, flu);
+        std::printf(
+            "coupling_throughput method=%s points=%ld threads=%d point_updates_per_s=%.4e share=%.3f "
+            "coupled_step_s=%.4e uncoupled_step_s=%.4e updates_per_step=%.0f substeps=%ld "
+            "phase_exchange=%.3f phase_structure=%.3f phase_fluid=%.3f\n",
+            m.c_str(), long(r.points), t, cost > 0 ? r.updates / cost : 0.0, cost / r.per_step, r.per_step, r0.per_step,
+            r.updates, r.substeps, exch, str, flu);
         std::fflush(stdout);
       };
       if (m == "penalty") {
         pf::coupling::penalty_options po;
         po.pfac = 1.0;
-        pf::explicit_stepper s{make_fluid(su), make_structure(su), pf::coupling::penalty{pf::porosity::impermeable{}, po}};
+        pf::explicit_stepper s{make_fluid(su), make_structure(su),
+                               pf::coupling::penalty{pf::porosity::impermeable{}, po}};
         s.fluid().set_threading(true);
         result r = time_stepper(s, su, [](auto& sp) {
           return double(sp.coupling().diagnostics().active_points) * double(sp.last_substeps());

@@ -38,10 +38,10 @@ void run(const char* fname, const char* rname, int n, int threads, int repeats, 
     rates.push_back(double(n) * n * n * steps / sec);
   }
   std::sort(rates.begin(), rates.end());
-  std::printf("fluid_throughput flux=%s recon=%s cells=%d threads=%d cell_updates_per_s=%.4g"
-              " min=%.4g max=%.4g simd_width=%zu\n",
-              fname, rname, n * n * n, threads, rates[rates.size() / 2], rates.front(), rates.back(),
-              pf::simd::width);
+  std::printf(
+      "fluid_throughput flux=%s recon=%s cells=%d threads=%d cell_updates_per_s=%.4g"
+      " min=%.4g max=%.4g simd_width=%zu\n",
+      fname, rname, n * n * n, threads, rates[rates.size() / 2], rates.front(), rates.back(), pf::simd::width);
   std::fflush(stdout);
 }
 

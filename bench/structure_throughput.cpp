@@ -44,16 +44,22 @@ void measure(const char* name, Part& part, st::nodes& nd, int repeats, int threa
     rate.push_back(double(part.size()) * reps / el);
   }
   std::sort(rate.begin(), rate.end());
-  std::printf("structure_throughput part=%s elements=%ld threads=%d simd=%s element_updates_per_s=%.4e min=%.4e "
-              "max=%.4e\n", name, long(part.size()), threads, simd ? "simd" : "scalar", rate[rate.size() / 2],
-              rate.front(), rate.back());
+  std::printf(
+      "structure_throughput part=%s elements=%ld threads=%d simd=%s element_updates_per_s=%.4e min=%.4e "
+      "max=%.4e\n",
+      name, long(part.size()), threads, simd ? "simd" : "scalar", rate[rate.size() / 2], rate.front(), rate.back());
 }
 
 int main(int argc, char** argv) {
   CLI::App app{"Element-update throughput of the structural force kernels"};
   int rings = 100, repeats = 7;
-  app.add_option("--rings", rings, "disk mesh radial divisions (6 N^2 triangles; quads: O-grid of ~the same node count)")->check(CLI::Range(2, 2000))->capture_default_str();
-  app.add_option("--repeats", repeats, "timed repeats (min/median/max)")->check(CLI::Range(1, 1000))->capture_default_str();
+  app.add_option("--rings", rings,
+                 "disk mesh radial divisions (6 N^2 triangles; quads: O-grid of ~the same node count)")
+      ->check(CLI::Range(2, 2000))
+      ->capture_default_str();
+  app.add_option("--repeats", repeats, "timed repeats (min/median/max)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   std::printf("# command: structure_throughput --rings %d --repeats %d  (simd width %zu doubles, OpenMP %s)\n", rings,
               repeats, parafsi::simd::width, parafsi::parallel::enabled() ? "on" : "off");
@@ -93,12 +99,48 @@ int main(int argc, char** argv) {
   quad.finalize(ndq);
   ndq.finalize_masses();
   for (int threads : {1, 2}) {
-    measure("membrane_tri", mem, nd, repeats, threads, [&](const auto& k) { mem.compute_forces<false, false>(k); mem.scatter<false>(nd); }, false);
-    measure("membrane_tri", mem, nd, repeats, threads, [&](const auto& k) { mem.compute_forces<false, true>(k); mem.scatter<false>(nd); }, true);
-    measure("membrane_quad", quad, ndq, repeats, threads, [&](const auto& k) { quad.compute_forces<false, false>(k); quad.scatter<false>(ndq); }, false);
-    measure("membrane_quad", quad, ndq, repeats, threads, [&](const auto& k) { quad.compute_forces<false, true>(k); quad.scatter<false>(ndq); }, true);
-    measure("cable", cab, nd, repeats, threads, [&](const auto& k) { cab.compute_forces<false, false>(k); cab.scatter<false>(nd); }, false);
-    measure("cable", cab, nd, repeats, threads, [&](const auto& k) { cab.compute_forces<false, true>(k); cab.scatter<false>(nd); }, true);
+    measure(
+        "membrane_tri", mem, nd, repeats, threads,
+        [&](const auto& k) {
+      mem.compute_forces<false, false>(k);
+      mem.scatter<false>(nd);
+        },
+        false);
+    measure(
+        "membrane_tri", mem, nd, repeats, threads,
+        [&](const auto& k) {
+      mem.compute_forces<false, true>(k);
+      mem.scatter<false>(nd);
+        },
+        true);
+    measure(
+        "membrane_quad", quad, ndq, repeats, threads,
+        [&](const auto& k) {
+      quad.compute_forces<false, false>(k);
+      quad.scatter<false>(ndq);
+        },
+        false);
+    measure(
+        "membrane_quad", quad, ndq, repeats, threads,
+        [&](const auto& k) {
+      quad.compute_forces<false, true>(k);
+      quad.scatter<false>(ndq);
+        },
+        true);
+    measure(
+        "cable", cab, nd, repeats, threads,
+        [&](const auto& k) {
+      cab.compute_forces<false, false>(k);
+      cab.scatter<false>(nd);
+        },
+        false);
+    measure(
+        "cable", cab, nd, repeats, threads,
+        [&](const auto& k) {
+      cab.compute_forces<false, true>(k);
+      cab.scatter<false>(nd);
+        },
+        true);
   }
   return 0;
 }

@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
   app.add_option("--shape", shape, "disk (flat, normal to the stream) or cup (hemisphere, open towards the stream)")
       ->check(CLI::IsMember({"disk", "cup"}))
       ->capture_default_str();
-  app.add_option("--coupling", coupling, "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
+  app.add_option("--coupling", coupling,
+                 "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
       ->capture_default_str();
   examples::add_cells_option(app, cells, "fluid cells across the body diameter D = 0.2 m", 4);
@@ -48,13 +49,15 @@ int main(int argc, char** argv) {
   app.add_option("--reynolds", Re, "Reynolds number U D / nu (sets a constant viscosity; 0 = inviscid)")
       ->check(CLI::Validator(
           [](std::string& s) {
-            double v = 0;
-            if (CLI::detail::lexical_cast(s, v) && (v == 0 || (v >= 1 && v <= 1e9))) return std::string();
-            return "Reynolds number " + s + " is neither 0 (inviscid) nor in [1, 1e9]";
+    double v = 0;
+    if (CLI::detail::lexical_cast(s, v) && (v == 0 || (v >= 1 && v <= 1e9))) return std::string();
+    return "Reynolds number " + s + " is neither 0 (inviscid) nor in [1, 1e9]";
           },
           "0 or [1 - 1e9]"))
       ->capture_default_str();
-  app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")->check(CLI::Range(1e-4, 1e3))->capture_default_str();
+  app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")
+      ->check(CLI::Range(1e-4, 1e3))
+      ->capture_default_str();
   app.add_option("--flow-times", flow_times, "run length in flow-through times D/U (ignored with --time)")
       ->check(CLI::Range(0.5, 1000.0))
       ->capture_default_str();
@@ -133,9 +136,10 @@ int main(int argc, char** argv) {
         prog.finish(s.time(), s.steps());
         csv.close();
         const double cd = sum_t > 0 ? sum / sum_t : 0.0;
-        std::printf("drag_coefficient=%.6g shape=%s coupling=%s cells_per_diameter=%d averaged_from_t=%.6g t_end=%.6g "
-                    "steps=%ld max_penetration_over_h=%.3g wall_seconds=%.1f\n",
-                    cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
+        std::printf(
+            "drag_coefficient=%.6g shape=%s coupling=%s cells_per_diameter=%d averaged_from_t=%.6g t_end=%.6g "
+            "steps=%ld max_penetration_over_h=%.3g wall_seconds=%.1f\n",
+            cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
         return 0;
       };
       if (coupling == "embedded") return run(pf::coupling::embedded{pf::porosity::impermeable{}});

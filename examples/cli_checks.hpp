@@ -15,10 +15,10 @@ namespace examples {
 /// prefixes the option's name). CLI::Range lets NaN through (every comparison with NaN
 /// is false); `parse` adds this validator to every floating-point option.
 inline const CLI::Validator finite{[](std::string& s) {
-                                     double v = 0;
-                                     if (!CLI::detail::lexical_cast(s, v)) return "'" + s + "' is not a number";
-                                     if (!std::isfinite(v)) return "value " + s + " is not a finite number";
-                                     return std::string();
+  double v = 0;
+  if (!CLI::detail::lexical_cast(s, v)) return "'" + s + "' is not a number";
+  if (!std::isfinite(v)) return "value " + s + " is not a finite number";
+  return std::string();
                                    },
                                    ""};
 

@@ -16,8 +16,6 @@
 // built from the same pieces.
 #include <CLI/CLI.hpp>
 
-#include "cli_checks.hpp"
-#include "step_guard.hpp"
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
 #include <parafsi/io/drop_history.hpp>
@@ -25,6 +23,8 @@
 #include <parafsi/parafsi.hpp>
 #include <parafsi/scene/drop_steps.hpp>
 #include <parafsi/structure/from_drop_scene.hpp>
+#include "cli_checks.hpp"
+#include "step_guard.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     //    the canopy (|ξx|, |ξy| ≤ 0.6 D0, along the axis from zc + 0.55 Ls to
     //    zc + Ls + 0.55 D0, zc the confluence), growing by 1.3 per cell outwards.
     pf::model::drop_box_parameters bp;
-    bp.cell = 0.2;    // D0/5 (drop_box_parameters are in units of D0)
+    bp.cell = 0.2;  // D0/5 (drop_box_parameters are in units of D0)
     bp.growth = 1.3;
     const pf::model::drop_box box = pf::model::make_drop_box(S, bp);
     const pf::fluid::rectilinear_grid grid = pf::scene::make_drop_grid(box);  // axis::refined per axis
@@ -76,8 +76,8 @@ int main(int argc, char** argv) {
     pf::frame::follow_payload follow;
     follow.axis = {0.0, 0.0, -1.0};  // box −z turns to the payload velocity
     follow.max_rate = 10.0;          // rad/s
-    pf::fluid::solver fluid{grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{},
-                            pf::viscosity::inviscid{}, follow};
+    pf::fluid::solver fluid{
+        grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{}, pf::viscosity::inviscid{}, follow};
     fluid.initialize([&](const Eigen::Vector3d&) { return air; });
     // Pose: the box axes (box +z along the canopy axis), origin and velocity those of the payload.
     pf::scene::place_drop_box(fluid, box, chute);

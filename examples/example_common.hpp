@@ -52,9 +52,7 @@ decltype(auto) with_limiter(const std::string& name, F&& f) {
 /// Resolve both names once: f(Flux{}, Recon{}); everything below is compile-time.
 template <class F>
 decltype(auto) dispatch(const std::string& flux, const std::string& limiter, F&& f) {
-  return with_flux(flux, [&](auto fl) {
-    return with_limiter(limiter, [&](auto rc) { return f(fl, rc); });
-  });
+  return with_flux(flux, [&](auto fl) { return with_limiter(limiter, [&](auto rc) { return f(fl, rc); }); });
 }
 
 // ---------------------------------------------------------------- options
@@ -68,9 +66,7 @@ struct common_options {
 };
 
 inline void add_flux_option(CLI::App& app, common_options& o) {
-  app.add_option("--flux", o.flux, "Riemann flux")
-      ->check(CLI::IsMember(flux_names))
-      ->capture_default_str();
+  app.add_option("--flux", o.flux, "Riemann flux")->check(CLI::IsMember(flux_names))->capture_default_str();
 }
 inline void add_limiter_option(CLI::App& app, common_options& o) {
   app.add_option("--limiter", o.limiter, "MUSCL limiter (none = first order)")
@@ -120,8 +116,8 @@ class progress {
     const double rate = double(steps) / el;
     const double frac = t_end_ > 0 ? t / t_end_ : 0.0;
     const double eta = frac > 0 ? el * (1.0 - frac) / frac : 0.0;
-    std::fprintf(stderr, "%s: t = %.6g / %.6g, %ld steps, %.1f steps/s, ETA %.1f s\n", label_.c_str(), t, t_end_,
-                 steps, rate, eta);
+    std::fprintf(stderr, "%s: t = %.6g / %.6g, %ld steps, %.1f steps/s, ETA %.1f s\n", label_.c_str(), t, t_end_, steps,
+                 rate, eta);
     printed_ = true;
   }
   void finish(double t, long steps) {

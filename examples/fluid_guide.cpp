@@ -12,10 +12,10 @@
 // CSV `xi_z,x,y,z,rho,ux,uy,uz,p` (box coordinate, inertial position, state).
 #include <CLI/CLI.hpp>
 
-#include "cli_checks.hpp"
-#include "step_guard.hpp"
 #include <parafsi/io/checked_file.hpp>
 #include <parafsi/parafsi.hpp>
+#include "cli_checks.hpp"
+#include "step_guard.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,8 +33,12 @@ int main(int argc, char** argv) {
   std::string out;
   app.add_option("--t-end", t_end, "simulated time (s)")->check(CLI::Range(0.0, 10.0))->capture_default_str();
   app.add_option("--speed", speed, "payload fall speed (m/s)")->check(CLI::Range(0.0, 100.0))->capture_default_str();
-  app.add_option("--drift", drift, "payload horizontal speed (m/s)")->check(CLI::Range(0.0, 100.0))->capture_default_str();
-  app.add_option("--h-fine", h_fine, "cell size around the payload (m)")->check(CLI::Range(0.02, 0.5))->capture_default_str();
+  app.add_option("--drift", drift, "payload horizontal speed (m/s)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--h-fine", h_fine, "cell size around the payload (m)")
+      ->check(CLI::Range(0.02, 0.5))
+      ->capture_default_str();
   app.add_option("--cfl", cfl, "CFL number of the stable step")->check(CLI::Range(0.01, 1.0))->capture_default_str();
   app.add_option("--threads", threads, "OpenMP threads")->check(CLI::Range(1, 1024))->capture_default_str();
   app.add_option("--out", out, "CSV of the line through the payload along the box z axis");
@@ -58,8 +62,13 @@ int main(int argc, char** argv) {
     pf::frame::follow_payload follow;
     follow.axis = {0.0, 0.0, -1.0};  // box −z points along the payload's velocity
     follow.max_rate = 10.0;          // rad/s (cap on the turning rate)
-    pf::fluid::solver s{grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{},
-                        pf::viscosity::sutherland{}, pf::turbulence::smagorinsky{}, follow};
+    pf::fluid::solver s{grid,
+                        bc,
+                        pf::flux::hllc_lm{},
+                        pf::recon::muscl<pf::limiter::van_leer>{},
+                        pf::viscosity::sutherland{},
+                        pf::turbulence::smagorinsky{},
+                        follow};
 
     // 4. Initial state (ξ: cell centre in box coordinates) and pose.
     s.initialize([&](const Eigen::Vector3d&) { return air; });
@@ -121,9 +130,9 @@ int main(int argc, char** argv) {
     std::printf("box_origin=(%.4f, %.4f, %.4f) m payload=(%.4f, %.4f, %.4f) m axis_to_velocity=%.2e rad\n",
                 s.pose().X.x(), s.pose().X.y(), s.pose().X.z(), payload(s.time()).x(), payload(s.time()).y(),
                 payload(s.time()).z(), angle);
-    std::printf("momentum_change=(%.4e, %.4e, %.4e) N s mass_change=%.3e kg\n",
-                after.momentum[0] - before.momentum[0], after.momentum[1] - before.momentum[1],
-                after.momentum[2] - before.momentum[2], after.mass - before.mass);
+    std::printf("momentum_change=(%.4e, %.4e, %.4e) N s mass_change=%.3e kg\n", after.momentum[0] - before.momentum[0],
+                after.momentum[1] - before.momentum[1], after.momentum[2] - before.momentum[2],
+                after.mass - before.mass);
     std::printf("p_min=%.2f Pa p_max=%.2f Pa\n", p_min, p_max);
 
     // 8. Optional CSV: the cells of the box z axis through the payload, placed in space.
@@ -141,8 +150,8 @@ int main(int argc, char** argv) {
       for (pf::index_t k = 0; k < grid.n(2); ++k) {
         const Eigen::Vector3d x = s.pose().to_inertial({grid.centre(0, i), grid.centre(1, j), grid.centre(2, k)});
         const auto w = s.primitive(i, j, k);
-        csv << grid.centre(2, k) << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << w.rho << ',' << w.u.x
-            << ',' << w.u.y << ',' << w.u.z << ',' << w.p << '\n';
+        csv << grid.centre(2, k) << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << w.rho << ',' << w.u.x << ','
+            << w.u.y << ',' << w.u.z << ',' << w.p << '\n';
       }
       pf::io::write_text_file(out, csv.str());
     }

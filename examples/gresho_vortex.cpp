@@ -73,8 +73,9 @@ int run(const options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Gresho vortex on [0,1]^2 x 2 cells in z at peak Mach number M; prints the kinetic-energy "
-               "ratio E_k(T)/E_k(0)."};
+  CLI::App app{
+      "Gresho vortex on [0,1]^2 x 2 cells in z at peak Mach number M; prints the kinetic-energy "
+      "ratio E_k(T)/E_k(0)."};
   options o;
   app.add_option("--mach", o.mach, "peak Mach number M (background pressure p0 = 1/(gamma M^2))")
       ->check(CLI::Range(1e-5, 2.0))
@@ -89,8 +90,7 @@ int main(int argc, char** argv) {
   if (!examples::parse(app, argc, argv, code)) return code;
   examples::apply_threads(o.common);
   return examples::guarded("gresho_vortex", [&] {
-    return examples::dispatch(o.common.flux, o.common.limiter, [&](auto fl, auto rc) {
-      return run<decltype(fl), decltype(rc)>(o);
-    });
+    return examples::dispatch(o.common.flux, o.common.limiter,
+                              [&](auto fl, auto rc) { return run<decltype(fl), decltype(rc)>(o); });
   });
 }

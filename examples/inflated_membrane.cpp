@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
       chute.integrator().mass_damping = 2.0 * omega1;
       const double w_hencky = ref.coefficient * a * std::cbrt(p * a / (E * h));
 
-      std::fprintf(stderr, "inflated_membrane: %zu %s, %ld nodes, dt = %.3e s, omega1 ~ %.3e rad/s\n", n_elements,
-                   kind, long(positions.size()), chute.stable_dt(), omega1);
+      std::fprintf(stderr, "inflated_membrane: %zu %s, %ld nodes, dt = %.3e s, omega1 ~ %.3e rad/s\n", n_elements, kind,
+                   long(positions.size()), chute.stable_dt(), omega1);
       st::relax_options ro;
       ro.tolerance = tol;
       ro.t_min = 2.0 * std::numbers::pi / omega1;

@@ -43,13 +43,14 @@ struct vortex : pf::fluid::reference::isentropic_vortex {
     gamma = gamma_;
     period = length;
   }
-  double dT_max() const { return (gamma_ - 1.0) * eps * eps / (8.0 * gamma_ * std::numbers::pi * std::numbers::pi) * std::exp(1.0); }
+  double dT_max() const {
+    return (gamma_ - 1.0) * eps * eps / (8.0 * gamma_ * std::numbers::pi * std::numbers::pi) * std::exp(1.0);
+  }
   /// Cell average of ρ over [x0, x1] × [y0, y1] (q × q midpoint rule).
   double mean_density(double x0, double x1, double y0, double y1, int q) const {
     double acc = 0.0;
     for (int b = 0; b < q; ++b)
-      for (int a = 0; a < q; ++a)
-        acc += (*this)(x0 + (x1 - x0) * (a + 0.5) / q, y0 + (y1 - y0) * (b + 0.5) / q).rho;
+      for (int a = 0; a < q; ++a) acc += (*this)(x0 + (x1 - x0) * (a + 0.5) / q, y0 + (y1 - y0) * (b + 0.5) / q).rho;
     return acc / double(q * q);
   }
 };
@@ -76,17 +77,17 @@ int run(const options& o, const vortex& v0) {
     for (pf::index_t i = 0; i < N; ++i) {
       const auto a = s.primitive(i, j, 0), b = s.primitive(i, j, 1);
       const double rho = 0.5 * (a.rho + b.rho);
-      csv.row({grid.centre(0, i), grid.centre(1, j), rho, 0.5 * (a.u.x + b.u.x), 0.5 * (a.u.y + b.u.y),
-               0.5 * (a.p + b.p)});
-      const double ex =
-          ve.mean_density(grid.face(0, i), grid.face(0, i + 1), grid.face(1, j), grid.face(1, j + 1), quadrature);
+      csv.row(
+          {grid.centre(0, i), grid.centre(1, j), rho, 0.5 * (a.u.x + b.u.x), 0.5 * (a.u.y + b.u.y), 0.5 * (a.p + b.p)});
+      const double ex = ve.mean_density(grid.face(0, i), grid.face(0, i + 1), grid.face(1, j), grid.face(1, j + 1),
+                                        quadrature);
       l1 += std::fabs(rho - ex);
     }
   csv.close();
   l1 /= double(N * N);
 
-  std::printf("isentropic_vortex flux=%s limiter=%s cells=%d p_inf=%.6g mach=%.6g t_end=%g steps=%ld\n",
-              Flux::name(), Recon::name(), o.cells, v0.p_inf,
+  std::printf("isentropic_vortex flux=%s limiter=%s cells=%d p_inf=%.6g mach=%.6g t_end=%g steps=%ld\n", Flux::name(),
+              Recon::name(), o.cells, v0.p_inf,
               std::hypot(v0.u_inf, v0.v_inf) / std::sqrt(gamma_ * v0.p_inf / v0.rho_inf), s.time(), s.steps());
   std::printf("l1_density_error=%.6e\n", l1);
   std::printf("wall_seconds=%.3f\n", wall);
@@ -96,8 +97,9 @@ int run(const options& o, const vortex& v0) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Isentropic vortex (Shu/Yee, eps = 5) advected one period on [-5,5]^2 x 2 cells in z; "
-               "prints the L1 density error against the exact solution."};
+  CLI::App app{
+      "Isentropic vortex (Shu/Yee, eps = 5) advected one period on [-5,5]^2 x 2 cells in z; "
+      "prints the L1 density error against the exact solution."};
   options o;
   examples::add_cells_option(app, o.cells, "cells per side of the x-y plane", 4);
   app.add_option("--mach", o.mach,
@@ -117,8 +119,7 @@ int main(int argc, char** argv) {
     if (o.mach > 0.0) v0.p_inf = v0.rho_inf * (v0.u_inf * v0.u_inf + v0.v_inf * v0.v_inf) / (gamma_ * o.mach * o.mach);
     pf::require(v0.p_inf / v0.rho_inf > 1.05 * v0.dT_max(), "--mach ", o.mach,
                 " is too high: the vortex core temperature would be non-positive");
-    return examples::dispatch(o.common.flux, o.common.limiter, [&](auto fl, auto rc) {
-      return run<decltype(fl), decltype(rc)>(o, v0);
-    });
+    return examples::dispatch(o.common.flux, o.common.limiter,
+                              [&](auto fl, auto rc) { return run<decltype(fl), decltype(rc)>(o, v0); });
   });
 }

@@ -86,8 +86,9 @@ int run(const options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Free-stream preservation: quiescent air in a box translating at 20 m/s and rotating at "
-               "1 rad/s; exits non-zero if the velocity or pressure deviation exceeds 1e-10 (relative)."};
+  CLI::App app{
+      "Free-stream preservation: quiescent air in a box translating at 20 m/s and rotating at "
+      "1 rad/s; exits non-zero if the velocity or pressure deviation exceeds 1e-10 (relative)."};
   options o;
   app.add_option("--steps", o.steps, "time steps")->check(CLI::Range(1L, 100000000L))->capture_default_str();
   examples::add_cells_option(app, o.cells, "cells per side of the cube", 2);
@@ -101,8 +102,7 @@ int main(int argc, char** argv) {
   if (!examples::parse(app, argc, argv, code)) return code;
   examples::apply_threads(o.common);
   return examples::guarded("moving_box", [&] {
-    return examples::dispatch(o.common.flux, o.common.limiter, [&](auto fl, auto rc) {
-      return run<decltype(fl), decltype(rc)>(o);
-    });
+    return examples::dispatch(o.common.flux, o.common.limiter,
+                              [&](auto fl, auto rc) { return run<decltype(fl), decltype(rc)>(o); });
   });
 }

@@ -57,8 +57,8 @@ std::vector<double> parse_list(const std::string& s) {
       used = 0;
     }
     if (used != item.size() || !std::isfinite(t) || t < 0)
-      throw CLI::ValidationError("--slice-times", "'" + item +
-                                 "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
+      throw CLI::ValidationError("--slice-times",
+                                 "'" + item + "' is not a time in seconds (expected a comma list such as 0.5,1,2)");
     v.push_back(t);
   }
   std::sort(v.begin(), v.end());  // slices are written in time order
@@ -85,10 +85,14 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"mat544", "mat59225", "mat509"}))
       ->capture_default_str();
   app.add_option("--resolution", c.resolution,
-                 "draft (element D0/20, cell D0/10), coarse (D0/30, D0/15), medium (D0/40, D0/20), fine (D0/60, D0/30); tiny for tests")
+                 "draft (element D0/20, cell D0/10), coarse (D0/30, D0/15), medium (D0/40, D0/20), fine (D0/60, "
+                 "D0/30); tiny for tests")
       ->check(CLI::IsMember({"draft", "coarse", "medium", "fine", "tiny"}))
       ->capture_default_str();
-  app.add_option("--t-end", c.t_end, "simulated time (s)")->check(finite)->check(CLI::Range(1e-4, 100.0))->capture_default_str();
+  app.add_option("--t-end", c.t_end, "simulated time (s)")
+      ->check(finite)
+      ->check(CLI::Range(1e-4, 100.0))
+      ->capture_default_str();
   app.add_option("--coupling", c.coupling,
                  "fluid-structure coupling: penalty (the paper's) or embedded (leak-free; impedance-stabilised)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
@@ -155,8 +159,9 @@ int main(int argc, char** argv) {
   app.add_option("--initial-speed", c.initial_speed, "override: release speed (m/s); default: the scene's")
       ->check(finite)
       ->check(CLI::Range(0.0, 200.0));
-  app.add_option("--viscosity", c.viscosity,
-                 "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
+  app.add_option(
+         "--viscosity", c.viscosity,
+         "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
   app.add_option("--impedance", c.impedance,

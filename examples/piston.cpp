@@ -18,8 +18,9 @@ namespace pf = parafsi;
 namespace st = pf::structure;
 
 int main(int argc, char** argv) {
-  CLI::App app{"Rigid plate driven into still air in a slip-wall duct (penalty or embedded coupling); "
-               "the pressure rise ahead of it against rho*c*v"};
+  CLI::App app{
+      "Rigid plate driven into still air in a slip-wall duct (penalty or embedded coupling); "
+      "the pressure rise ahead of it against rho*c*v"};
   examples::common_options co;
   double v = 2.0, pfac = 1.0, t_end = 3e-3;
   int cells = 100;
@@ -84,7 +85,8 @@ int main(int argc, char** argv) {
             usum += s.fluid().primitive(i, 0, 0).u.x;
             ++n;
           }
-        if (n == 0) throw pf::invalid_input("piston: no cells between the plate and the front; raise --cells or --time");
+        if (n == 0)
+          throw pf::invalid_input("piston: no cells between the plate and the front; raise --cells or --time");
         const double rise = sum / n - p0, ref = rho * c * v;
         if (!out.empty()) {
           examples::csv_writer csv(out, "x,p,u");
@@ -95,9 +97,10 @@ int main(int argc, char** argv) {
           csv.close();
         }
         const double ua = usum / n;
-        std::printf("pressure_rise=%.6g rho_c_v=%.6g relative_error=%.4e air_velocity=%.6g leak_velocity=%.6g "
-                    "rho_c_u_air=%.6g max_penetration_over_h=%.4g\n",
-                    rise, ref, rise / ref - 1.0, ua, v - ua, rho * c * ua, max_pen);
+        std::printf(
+            "pressure_rise=%.6g rho_c_v=%.6g relative_error=%.4e air_velocity=%.6g leak_velocity=%.6g "
+            "rho_c_u_air=%.6g max_penetration_over_h=%.4g\n",
+            rise, ref, rise / ref - 1.0, ua, v - ua, rho * c * ua, max_pen);
         return 0;
       };
       if (coupling == "embedded") return run(pf::coupling::embedded{pf::porosity::impermeable{}});

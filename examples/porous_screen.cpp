@@ -9,8 +9,8 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
-#include <parafsi/model/fabric_catalogue.hpp>
 #include <parafsi/model/duct_screen.hpp>
+#include <parafsi/model/fabric_catalogue.hpp>
 
 #include <filesystem>
 
@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"mat544", "mat59225", "mat509"}))
       ->capture_default_str();
   app.add_option("--velocity", V, "inflow velocity (m/s)")->check(CLI::Range(1e-4, 50.0))->capture_default_str();
-  app.add_option("--coupling", coupling, "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
+  app.add_option("--coupling", coupling,
+                 "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
       ->capture_default_str();
   examples::add_cells_option(app, cells, "cells along the 1 m duct", 10);
@@ -66,49 +67,58 @@ int main(int argc, char** argv) {
       pf::coupling::penalty_options po;
       po.pfac = pfac;
       auto run = [&](auto cpl) -> int {
-      pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
-      const auto& g = s.fluid().grid();
-      auto measure = [&](double& dp, double& u) {
-        double pu = 0, pd = 0, uu = 0;
-        int nu = 0, nd2 = 0;
-        for (pf::index_t k = 0; k < 2; ++k)
-          for (pf::index_t j = 0; j < 2; ++j)
-            for (pf::index_t i = 0; i < g.n(0); ++i) {
-              const double x = g.centre(0, i);
-              const auto w = s.fluid().primitive(i, j, k);
-              if (x > xs - 0.2 && x < xs - 0.1) { pu += w.p; uu += w.u.x; ++nu; }
-              if (x > xs + 0.1 && x < xs + 0.2) { pd += w.p; ++nd2; }
-            }
-        if (nu == 0 || nd2 == 0) throw pf::invalid_input("porous_screen: no cells in the probe windows; raise --cells");
-        dp = pu / nu - pd / nd2;
-        u = uu / nu;
-      };
-      examples::csv_writer csv(out, "t,pressure_drop,through_velocity");
-      examples::progress prog("porous_screen", t_end, co.quiet);
-      double dp = 0, u = 0;
-      long next_row = 0;
-      double max_pen = 0;
-      examples::step_guard guard("porous_screen", t_end);
-      while (s.time() < t_end - 1e-15) {
-        s.step(std::min(guard(s.stable_dt(co.cfl), s.time()), t_end - s.time()));
-        max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
-        if (s.steps() >= next_row) {
-          measure(dp, u);
-          csv.row({s.time(), dp, u});
-          next_row += 20;
+        pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
+        const auto& g = s.fluid().grid();
+        auto measure = [&](double& dp, double& u) {
+          double pu = 0, pd = 0, uu = 0;
+          int nu = 0, nd2 = 0;
+          for (pf::index_t k = 0; k < 2; ++k)
+            for (pf::index_t j = 0; j < 2; ++j)
+              for (pf::index_t i = 0; i < g.n(0); ++i) {
+                const double x = g.centre(0, i);
+                const auto w = s.fluid().primitive(i, j, k);
+                if (x > xs - 0.2 && x < xs - 0.1) {
+                  pu += w.p;
+                  uu += w.u.x;
+                  ++nu;
+                }
+                if (x > xs + 0.1 && x < xs + 0.2) {
+                  pd += w.p;
+                  ++nd2;
+                }
+              }
+          if (nu == 0 || nd2 == 0)
+            throw pf::invalid_input("porous_screen: no cells in the probe windows; raise --cells");
+          dp = pu / nu - pd / nd2;
+          u = uu / nu;
+        };
+        examples::csv_writer csv(out, "t,pressure_drop,through_velocity");
+        examples::progress prog("porous_screen", t_end, co.quiet);
+        double dp = 0, u = 0;
+        long next_row = 0;
+        double max_pen = 0;
+        examples::step_guard guard("porous_screen", t_end);
+        while (s.time() < t_end - 1e-15) {
+          s.step(std::min(guard(s.stable_dt(co.cfl), s.time()), t_end - s.time()));
+          max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
+          if (s.steps() >= next_row) {
+            measure(dp, u);
+            csv.row({s.time(), dp, u});
+            next_row += 20;
+          }
+          prog(s.time(), s.steps());
         }
-        prog(s.time(), s.steps());
-      }
-      prog.finish(s.time(), s.steps());
-      measure(dp, u);
-      csv.row({s.time(), dp, u});
-      csv.close();
-      const double ergun_dp = law.pressure_jump(u);
-      std::printf("pressure_drop=%.6g through_velocity=%.6g ergun_pressure_drop=%.6g relative_error=%.4e "
-                  "law_through_flow_velocity=%.6g max_penetration_over_h=%.4g\n",
-                  dp, u, ergun_dp, dp / ergun_dp - 1.0, s.coupling().total_through_flow() / s.coupling().coupled_area(),
-                  max_pen);
-      return 0;
+        prog.finish(s.time(), s.steps());
+        measure(dp, u);
+        csv.row({s.time(), dp, u});
+        csv.close();
+        const double ergun_dp = law.pressure_jump(u);
+        std::printf(
+            "pressure_drop=%.6g through_velocity=%.6g ergun_pressure_drop=%.6g relative_error=%.4e "
+            "law_through_flow_velocity=%.6g max_penetration_over_h=%.4g\n",
+            dp, u, ergun_dp, dp / ergun_dp - 1.0, s.coupling().total_through_flow() / s.coupling().coupled_area(),
+            max_pen);
+        return 0;
       };
       if (coupling == "embedded") return run(pf::coupling::embedded{law});
       return run(pf::coupling::penalty{law, po});

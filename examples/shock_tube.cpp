@@ -110,8 +110,9 @@ int run(const options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Toro's 1-D Riemann problems (Sod, Lax, 123, blast) along one axis of the 3-D fluid solver; "
-               "writes x,rho,u,p and prints L1 errors against the exact solution."};
+  CLI::App app{
+      "Toro's 1-D Riemann problems (Sod, Lax, 123, blast) along one axis of the 3-D fluid solver; "
+      "writes x,rho,u,p and prints L1 errors against the exact solution."};
   options o;
   std::vector<std::string> problem_names;
   for (const auto& [k, v] : problems) problem_names.push_back(k);
@@ -121,7 +122,9 @@ int main(int argc, char** argv) {
   examples::add_flux_option(app, o.common);
   examples::add_limiter_option(app, o.common);
   examples::add_cells_option(app, o.cells, "cells along the axis", 2);
-  app.add_option("--axis", o.axis, "box axis of the tube")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
+  app.add_option("--axis", o.axis, "box axis of the tube")
+      ->check(CLI::IsMember({"x", "y", "z"}))
+      ->capture_default_str();
   app.add_option("--t-end", o.t_end, "end time (default: the problem's)")->check(CLI::Range(0.0, 1e3));
   examples::add_out_option(app, o.out);
   examples::add_run_options(app, o.common);
@@ -129,8 +132,7 @@ int main(int argc, char** argv) {
   if (!examples::parse(app, argc, argv, code)) return code;
   examples::apply_threads(o.common);
   return examples::guarded("shock_tube", [&] {
-    return examples::dispatch(o.common.flux, o.common.limiter, [&](auto fl, auto rc) {
-      return run<decltype(fl), decltype(rc)>(o);
-    });
+    return examples::dispatch(o.common.flux, o.common.limiter,
+                              [&](auto fl, auto rc) { return run<decltype(fl), decltype(rc)>(o); });
   });
 }

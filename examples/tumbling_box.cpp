@@ -94,8 +94,7 @@ int main(int argc, char** argv) {
   app.add_option("--dt", dt, "time step (s); default 1e-3/|omega| (1 mrad per step)")
       ->check(positive_validator())
       ->check(CLI::Range(1e-12, 1e3));
-  app.add_option("--every", every, "write every N-th step (default: at most ~20000 rows)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--every", every, "write every N-th step (default: at most ~20000 rows)")->check(CLI::PositiveNumber);
   app.add_option("--out", out_path, "output CSV file")->required();
   if (int rc = 0; !examples::parse(app, argc, argv, rc)) return rc;
 
@@ -111,8 +110,8 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 3; ++k)
       parafsi::require(inertia[k] <= inertia[(k + 1) % 3] + inertia[(k + 2) % 3], "--inertia: the principal moments ",
                        inertia.x(), ",", inertia.y(), ",", inertia.z(), " violate the triangle inequality");
-    rigid_body body({1.0, inertia}, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(),
-                    Eigen::Vector3d::Zero(), omega0);
+    rigid_body body({1.0, inertia}, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(),
+                    omega0);
     const bool dt_from_omega = dt == 0;
     if (dt_from_omega) dt = 1e-3 / omega0.norm();
     dt = std::min(dt, t_end);
@@ -122,8 +121,8 @@ int main(int argc, char** argv) {
                      " steps, more than 1e8 (raise --dt or shorten --t-end)");
     const long n_steps = static_cast<long>(std::ceil(t_end / dt - 1e-9));
     if (dt > body.critical_dt())
-      std::cerr << "tumbling_box: warning: dt = " << dt << " exceeds the rotational limit critical_dt = "
-                << body.critical_dt() << " s\n";
+      std::cerr << "tumbling_box: warning: dt = " << dt
+                << " exceeds the rotational limit critical_dt = " << body.critical_dt() << " s\n";
     if (every == 0) every = std::max(1L, n_steps / 20000);
 
     parafsi::io::checked_file csv_file(out_path);  // opened now: a bad --out fails before the run
@@ -134,8 +133,8 @@ int main(int argc, char** argv) {
     auto ang_mom = [&] { return (body.inertia_body() * body.angular_velocity_body()).norm(); };
     auto write_row = [&](double t) {
       const Eigen::Vector3d w = body.angular_velocity_body();
-      csv << t << ',' << w.x() << ',' << w.y() << ',' << w.z() << ',' << body.kinetic_energy() << ','
-          << ang_mom() << '\n';
+      csv << t << ',' << w.x() << ',' << w.y() << ',' << w.z() << ',' << body.kinetic_energy() << ',' << ang_mom()
+          << '\n';
     };
     const double E0 = body.kinetic_energy(), L0 = ang_mom();
     double dE = 0, dL = 0;

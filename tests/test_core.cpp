@@ -87,8 +87,9 @@ TEST_CASE("parallel::reduce is independent of the thread count") {
   const int t0 = parallel::max_threads();
   auto run = [&](int t) {
     parallel::set_threads(t);
-    return parallel::reduce(index_t(0), index_t(x.size()), 0.0, [&](index_t i) { return x[std::size_t(i)]; },
-                            [](double a, double b) { return a + b; });
+    return parallel::reduce(
+        index_t(0), index_t(x.size()), 0.0, [&](index_t i) { return x[std::size_t(i)]; },
+        [](double a, double b) { return a + b; });
   };
   const double r1 = run(1), r2 = run(2);
   parallel::set_threads(t0);

@@ -59,7 +59,8 @@ double disk_drag(int cells, double flow_times, Coupling cpl) {
 
 }  // namespace
 
-TEST_CASE("bluff body: fixed disk drag coefficient within 15 % of the 1.12-1.17 range (embedded, 6 cells per diameter)") {
+TEST_CASE(
+    "bluff body: fixed disk drag coefficient within 15 % of the 1.12-1.17 range (embedded, 6 cells per diameter)") {
   const double cd = disk_drag(6, 16.0, pf::coupling::embedded{pf::porosity::impermeable{}});
   MESSAGE("disk C_d (embedded, D/h = 6, mean over 8-16 D/U) = " << cd);
   // Within 15 % of the published range 1.12–1.17 (the criterion); the coarse

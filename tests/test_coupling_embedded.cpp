@@ -77,7 +77,7 @@ namespace {
 template <class Porosity>
 auto layered_box(Porosity por, std::vector<double> xs) {
   pf::fluid::solver fl{ctu::duct_grid(pf::model::duct_screen(1.0, 16, xs.front())),
-                      pf::boundary::set::all(pf::boundary::slip_wall{})};
+                       pf::boundary::set::all(pf::boundary::slip_wall{})};
   fl.initialize([&](const Eigen::Vector3d& xi) {
     return pf::fluid::prim<double>{1.2, {0, 0, 0}, xi.x() < 0.5 ? 101350.0 : 101300.0};
   });
@@ -112,10 +112,11 @@ void run_layers(S& s, const char* label, pf::index_t expect_multi) {
                                               (i < 9 ? x0.x() : s.structure().node_set().position(i).x())));
   }
   const double dm = s.fluid().totals().mass - m0;
-  std::printf("%s: %d steps to t = %.2f ms, faces %ld (multi-layer %ld), mass change %.2e kg (of %.3e), "
-              "max step mass defect %.2e kg, sum of defects + change %.1e kg, max first-sheet displacement %.2e m\n",
-              label, int(s.steps()), 1e3 * s.time(), long(s.coupling().diagnostics().faces), long(multi), dm, m0,
-              max_defect, dm + sum_defect, max_disp);
+  std::printf(
+      "%s: %d steps to t = %.2f ms, faces %ld (multi-layer %ld), mass change %.2e kg (of %.3e), "
+      "max step mass defect %.2e kg, sum of defects + change %.1e kg, max first-sheet displacement %.2e m\n",
+      label, int(s.steps()), 1e3 * s.time(), long(s.coupling().diagnostics().faces), long(multi), dm, m0, max_defect,
+      dm + sum_defect, max_disp);
   for (pf::index_t k = 0; k < 2; ++k)
     for (pf::index_t j = 0; j < 2; ++j)
       for (pf::index_t i = 0; i < 16; ++i) {

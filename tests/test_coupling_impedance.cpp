@@ -73,8 +73,8 @@ TEST_CASE("embedded impedance: a heavy plate radiating into the duct decays as e
     while (s.time() < t_end - 1e-15) s.step(std::min(s.stable_dt(0.5), t_end - s.time()));
     const double exact = v0 * std::exp(-2.0 * rho0 * c * s.time() / m);
     const double v = plate_velocity(s);
-    std::printf("heavy plate, impedance %.0f: v(%.1e s) = %.6f m/s, exact %.6f (%+.3f %%), %ld steps\n", zeta,
-                s.time(), v, exact, 100 * (v / exact - 1), s.steps());
+    std::printf("heavy plate, impedance %.0f: v(%.1e s) = %.6f m/s, exact %.6f (%+.3f %%), %ld steps\n", zeta, s.time(),
+                v, exact, 100 * (v / exact - 1), s.steps());
     CHECK(v == doctest::Approx(exact).epsilon(0.02));
   }
 }
@@ -122,9 +122,10 @@ TEST_CASE("embedded impedance: a fabric-weight plate is added-mass unstable with
       if (k == 2) dP = (air_momentum_x(s) - P0) + (Ms * v - Ps0) - in_flight;
     }
     const double v = plate_velocity(s);
-    std::printf("fabric-weight plate, impedance 1: v = %.3e m/s after 20 steps (max |v| %.3e); over 3 steps "
-                "dP_air + dP_plate - impedance impulse = %.2e N s (m v0 = %.2e N s)\n",
-                v, vmax, dP, Ms * v0);
+    std::printf(
+        "fabric-weight plate, impedance 1: v = %.3e m/s after 20 steps (max |v| %.3e); over 3 steps "
+        "dP_air + dP_plate - impedance impulse = %.2e N s (m v0 = %.2e N s)\n",
+        v, vmax, dP, Ms * v0);
     CHECK(std::fabs(v) < 0.1 * v0);
     CHECK(vmax <= v0 * (1 + 1e-12));
     CHECK(std::fabs(dP) < 1e-8 * Ms * v0);  // round-off of the summed cell momenta

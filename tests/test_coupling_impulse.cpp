@@ -113,8 +113,8 @@ TEST_CASE_TEMPLATE_APPLY(impermeable, ctu::couplings);
 TEST_CASE_TEMPLATE_DEFINE("impulse balance with structure substeps and a porous fabric", C, porous) {
   using B = balance<C>;
   const auto& f = pf::model::fabric_catalogue[2];
-  auto s = ctu::tilted_patch(C::make(pf::porosity::ergun{f.alpha, f.beta, f.thickness}, B::pfac_porous), B::rho,
-                             0.05, 5e10);
+  auto s = ctu::tilted_patch(C::make(pf::porosity::ergun{f.alpha, f.beta, f.thickness}, B::pfac_porous), B::rho, 0.05,
+                             5e10);
   check_balance<C>(s, 40, "ergun mat509, stiff membrane");
   CHECK(s.last_substeps() > 1);
 }

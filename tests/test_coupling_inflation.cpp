@@ -120,8 +120,17 @@ TEST_CASE("a porous membrane blown by a stream reaches a steady inflated shape (
         const double x = g.centre(0, i);
         const auto w = s.fluid().primitive(i, j, k);
         REQUIRE(std::isfinite(w.p));
-        if (x > xs - 0.2 && x < xs - 0.1) { pu += w.p; uu += w.u.x; mu += w.rho * w.u.x; ++nu_; }
-        if (x > xs + 0.1 + w_c && x < xs + 0.2 + w_c) { pd += w.p; md += w.rho * w.u.x; ++nd_; }
+        if (x > xs - 0.2 && x < xs - 0.1) {
+          pu += w.p;
+          uu += w.u.x;
+          mu += w.rho * w.u.x;
+          ++nu_;
+        }
+        if (x > xs + 0.1 + w_c && x < xs + 0.2 + w_c) {
+          pd += w.p;
+          md += w.rho * w.u.x;
+          ++nd_;
+        }
       }
   REQUIRE(nu_ > 0);
   REQUIRE(nd_ > 0);
@@ -151,19 +160,21 @@ TEST_CASE("a porous membrane blown by a stream reaches a steady inflated shape (
 
   std::printf("inflated sheet: t = %.3f s, %ld steps; centre deflection %.5f m (at 0.8 t_end %.5f m), K/Kpeak %.2e\n",
               s.time(), s.steps(), w_c, w_at_80, k_end / k_peak);
-  std::printf("  dp = %.3f Pa, u_through = %.5f m/s (inflow %.2f), Ergun dp = %.3f Pa (error %+.2f %%); "
-              "rho u up/down %.5f / %.5f kg/(m^2 s)\n",
-              dp, u_through, V, dp_ergun, 100 * (dp / dp_ergun - 1), mass_flux_up, mass_flux_down);
-  std::printf("  structure-only under uniform dp: centre %.5f m (coupled/ref - 1 = %+.2f %%), profile max diff %.2f %% "
-              "of the centre deflection\n",
-              w_ref, 100 * (w_c / w_ref - 1), 100 * profile / w_ref);
+  std::printf(
+      "  dp = %.3f Pa, u_through = %.5f m/s (inflow %.2f), Ergun dp = %.3f Pa (error %+.2f %%); "
+      "rho u up/down %.5f / %.5f kg/(m^2 s)\n",
+      dp, u_through, V, dp_ergun, 100 * (dp / dp_ergun - 1), mass_flux_up, mass_flux_down);
+  std::printf(
+      "  structure-only under uniform dp: centre %.5f m (coupled/ref - 1 = %+.2f %%), profile max diff %.2f %% "
+      "of the centre deflection\n",
+      w_ref, 100 * (w_c / w_ref - 1), 100 * profile / w_ref);
 
-  CHECK(w_c > 0.0);                                                // bulges downstream
-  CHECK(w_c > 0.5 * W / 16);                                       // a real inflation (half a cell or more)
-  CHECK(k_end / k_peak < 1e-4);                                    // at rest
-  CHECK(std::fabs(w_c / w_at_80 - 1.0) < 2e-3);                    // steady shape
-  CHECK(std::fabs(dp / dp_ergun - 1.0) < 0.10);                    // the Ergun law holds on the inflated sheet
-  CHECK(std::fabs(mass_flux_down / mass_flux_up - 1.0) < 0.01);    // mass through the sheet
-  CHECK(std::fabs(w_c / w_ref - 1.0) < 0.05);                      // the shape of a uniformly loaded sheet
+  CHECK(w_c > 0.0);                                              // bulges downstream
+  CHECK(w_c > 0.5 * W / 16);                                     // a real inflation (half a cell or more)
+  CHECK(k_end / k_peak < 1e-4);                                  // at rest
+  CHECK(std::fabs(w_c / w_at_80 - 1.0) < 2e-3);                  // steady shape
+  CHECK(std::fabs(dp / dp_ergun - 1.0) < 0.10);                  // the Ergun law holds on the inflated sheet
+  CHECK(std::fabs(mass_flux_down / mass_flux_up - 1.0) < 0.01);  // mass through the sheet
+  CHECK(std::fabs(w_c / w_ref - 1.0) < 0.05);                    // the shape of a uniformly loaded sheet
   CHECK(profile < 0.05 * w_ref);
 }

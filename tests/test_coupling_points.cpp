@@ -26,7 +26,9 @@ TEST_CASE("coupling points: NQUAD from the cell size, weights, density rule") {
   for (index_t c = 0; c < pts.size(); ++c) {
     CHECK(pts.weight(c, 0) + pts.weight(c, 1) + pts.weight(c, 2) == doctest::Approx(1.0).epsilon(1e-15));
     for (int a = 0; a < 3; ++a) CHECK(pts.weight(c, a) > 0.0);
-    s0 += pts.weight(c, 0); s1 += pts.weight(c, 1); s2 += pts.weight(c, 2);
+    s0 += pts.weight(c, 0);
+    s1 += pts.weight(c, 1);
+    s2 += pts.weight(c, 2);
   }
   // Sub-triangle centroids average to the centroid: each node carries a third.
   CHECK(s0 / pts.size() == doctest::Approx(1.0 / 3.0).epsilon(1e-13));
@@ -42,7 +44,8 @@ TEST_CASE("grid locator: partition of unity and exact linear interpolation") {
   // Uniform (fast path) and stretched (binary search) grids.
   const auto uni = pf::fluid::rectilinear_grid::uniform({12, 9, 7}, {-1, 0, 0}, {1, 1, 0.7});
   const pf::fluid::rectilinear_grid str{pf::fluid::axis::refined(-1, 1, -0.2, 0.2, 0.05, 1.2),
-                                        pf::fluid::axis::uniform(9, 0, 1), pf::fluid::axis::refined(0, 1, 0.4, 0.6, 0.05, 1.3)};
+                                        pf::fluid::axis::uniform(9, 0, 1),
+                                        pf::fluid::axis::refined(0, 1, 0.4, 0.6, 0.05, 1.3)};
   for (const auto* g : {&uni, &str}) {
     const pf::coupling::grid_locator loc(*g);
     auto lin = [](const Eigen::Vector3d& p) { return 1.5 + 2.0 * p.x() - 0.7 * p.y() + 3.1 * p.z(); };

@@ -97,9 +97,10 @@ struct screen<ctu::penalty> {
     }
   }
   static void finish(const tally& t) {
-    std::printf("porous screen, penalty (PFAC 1): worst |error| over 3 fabrics x {20, 500} Pa = %.2f %%; at the "
-                "embedded inflow speeds %.2f %%\n",
-                100 * t.worst, 100 * t.worst_reported);
+    std::printf(
+        "porous screen, penalty (PFAC 1): worst |error| over 3 fabrics x {20, 500} Pa = %.2f %%; at the "
+        "embedded inflow speeds %.2f %%\n",
+        100 * t.worst, 100 * t.worst_reported);
     CHECK(t.worst < 0.10);
   }
 
@@ -123,8 +124,7 @@ struct screen<ctu::embedded> {
   static void run_fabric(tally& t, std::size_t fi, const pf::porosity::ergun& law, const char* name) {
     for (double V : V_in[fi]) {
       double dp = 0;
-      const double e_lm =
-          screen_error(ctu::embedded::make(law, 0), law, V, pf::flux::hllc_lm{}, "embedded", name, &dp);
+      const double e_lm = screen_error(ctu::embedded::make(law, 0), law, V, pf::flux::hllc_lm{}, "embedded", name, &dp);
       const double e_h = screen_error(ctu::embedded::make(law, 0), law, V, pf::flux::hllc{}, "embedded", name);
       CHECK(std::fabs(e_lm) < 0.10);
       CHECK(std::fabs(e_h) < 1e-2);
@@ -149,9 +149,10 @@ struct screen<ctu::embedded> {
   /// wall); less than the penalty wall (PFAC 1) at the same resolution.
   static void check_leak(double leak, double u544, int cells) {
     const double lp = leak_of(ctu::penalty::make(pf::porosity::impermeable{}, 1.0), cells);
-    std::printf("leak box %d cells: embedded leak %.3e m/s (%.4f %% of mat544's %.4f m/s), penalty (PFAC 1) leak "
-                "%.3e m/s (%.1f %%)\n",
-                cells, leak, 100 * std::fabs(leak) / u544, u544, lp, 100 * lp / u544);
+    std::printf(
+        "leak box %d cells: embedded leak %.3e m/s (%.4f %% of mat544's %.4f m/s), penalty (PFAC 1) leak "
+        "%.3e m/s (%.1f %%)\n",
+        cells, leak, 100 * std::fabs(leak) / u544, u544, lp, 100 * lp / u544);
     CHECK(std::fabs(leak) < 0.1 * u544);
     CHECK(std::fabs(leak) < 1e-12);
     CHECK(lp > std::fabs(leak));
@@ -198,9 +199,10 @@ TEST_CASE_TEMPLATE_DEFINE("leak box: an impermeable membrane with 50 Pa across",
   const double u544 = mat544.through_velocity(50.0);
   for (int cells : screen<C>::leak_cells) {
     const double leak = leak_of(C::make(pf::porosity::impermeable{}, 1.0), cells);
-    std::printf("leak box, %s, %d cells: mean leak over 2 ms = %.5f m/s = %.0f %% of mat544's Ergun through-flow "
-                "at 50 Pa (%.3f m/s)\n",
-                C::name, cells, leak, 100 * leak / u544, u544);
+    std::printf(
+        "leak box, %s, %d cells: mean leak over 2 ms = %.5f m/s = %.0f %% of mat544's Ergun through-flow "
+        "at 50 Pa (%.3f m/s)\n",
+        C::name, cells, leak, 100 * leak / u544, u544);
     screen<C>::check_leak(leak, u544, cells);
   }
 }

@@ -31,8 +31,8 @@ TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
   const auto& e = r.history.back();
   std::printf("drop regression: cells %ld, steps %ld, wall %.2f s\n", r.cells, r.steps, r.wall);
   std::printf("  t=%.4f z=%.6f speed=%.6f D=%.6f F=%.6f phi=(%.4g, %.4g) F_p=%.6f t_p=%.4f D_max=%.6f\n", e.t, e.z,
-              e.speed, e.canopy_diameter, e.open_force, e.canopy_phi_x, e.canopy_phi_y, r.summary.F_p,
-              r.summary.t_p, r.summary.max_diameter);
+              e.speed, e.canopy_diameter, e.open_force, e.canopy_phi_x, e.canopy_phi_y, r.summary.F_p, r.summary.t_p,
+              r.summary.max_diameter);
   CHECK(e.t == Approx(0.25).epsilon(1e-12));
   CHECK(r.history.size() == 51);  // one row per 5 ms and the start
   // Physical bounds: released at 8 m/s downwards, the payload falls at most as in vacuum
@@ -64,43 +64,43 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   parafsi::parallel::set_threads(1);
   const fs::path base = fs::temp_directory_path() / "parafsi_drop_restart";
   for (const char* coupling : {"penalty", "embedded"}) {
-  CAPTURE(coupling);
-  fs::remove_all(base);
-  fs::create_directories(base / "a");
-  fs::create_directories(base / "b");
-  parafsi::scene::drop_config c;
-  c.resolution = "tiny";
-  c.coupling = coupling;
-  c.pgs_alpha = 0.0;  // auto: 8 with embedded (the program's default), 1 with penalty (the paper's method)
-  c.t_end = 0.1;
-  c.initial_speed = 8.0;
-  c.quiet = true;
-  c.out = (base / "a").string();
-  c.checkpoint_every = 0.06;
-  const auto full = parafsi::scene::run_drop(c);
+    CAPTURE(coupling);
+    fs::remove_all(base);
+    fs::create_directories(base / "a");
+    fs::create_directories(base / "b");
+    parafsi::scene::drop_config c;
+    c.resolution = "tiny";
+    c.coupling = coupling;
+    c.pgs_alpha = 0.0;  // auto: 8 with embedded (the program's default), 1 with penalty (the paper's method)
+    c.t_end = 0.1;
+    c.initial_speed = 8.0;
+    c.quiet = true;
+    c.out = (base / "a").string();
+    c.checkpoint_every = 0.06;
+    const auto full = parafsi::scene::run_drop(c);
 
-  // Into another directory, without the first run's history.csv: the checkpoint carries
-  // the rows up to its time, so the history and summary cover the whole run.
-  fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
-  c.out = (base / "b").string();
-  c.checkpoint_every = 0;
-  c.restart = (base / "b" / "checkpoint.ckpt").string();
-  const auto cont = parafsi::scene::run_drop(c);
+    // Into another directory, without the first run's history.csv: the checkpoint carries
+    // the rows up to its time, so the history and summary cover the whole run.
+    fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
+    c.out = (base / "b").string();
+    c.checkpoint_every = 0;
+    c.restart = (base / "b" / "checkpoint.ckpt").string();
+    const auto cont = parafsi::scene::run_drop(c);
 
-  REQUIRE(full.history.size() == 21);
-  REQUIRE(cont.history.size() == full.history.size());
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < full.history.size(); ++i) {
-    const auto a = full.history[i].values(), b = cont.history[i].values();
-    for (std::size_t k = 0; k < a.size(); ++k)
-      if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
-  }
-  CHECK(differing == 0);
-  CHECK(cont.history.back().t == full.history.back().t);
-  CHECK(cont.summary.F_p == full.summary.F_p);
-  CHECK(cont.summary.t_p == full.summary.t_p);
-  // The step count is part of the restored state: the restarted run ends at the same count.
-  CHECK(cont.steps == full.steps);
+    REQUIRE(full.history.size() == 21);
+    REQUIRE(cont.history.size() == full.history.size());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < full.history.size(); ++i) {
+      const auto a = full.history[i].values(), b = cont.history[i].values();
+      for (std::size_t k = 0; k < a.size(); ++k)
+        if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
+    }
+    CHECK(differing == 0);
+    CHECK(cont.history.back().t == full.history.back().t);
+    CHECK(cont.summary.F_p == full.summary.F_p);
+    CHECK(cont.summary.t_p == full.summary.t_p);
+    // The step count is part of the restored state: the restarted run ends at the same count.
+    CHECK(cont.steps == full.steps);
   }
   // A checkpoint restarted with another pressure-gradient scaling is refused, naming both
   // pressures (the checkpoint holds the air, the far field comes from the flags).
@@ -154,35 +154,37 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
     const char* name;
     void (*apply)(cfg&);
   };
-  const change changes[] = {
-      {"canopy", [](cfg& c) { c.canopy = "c9"; }},
-      {"fabric", [](cfg& c) { c.fabric = "mat509"; }},
-      {"cell", [](cfg& c) { c.cell = 0.3; }},
-      {"element", [](cfg& c) { c.element = 0.15; }},
-      {"growth", [](cfg& c) { c.growth = 1.5; }},
-      {"coupling", [](cfg& c) { c.coupling = "penalty"; }},
-      {"pgs_alpha", [](cfg& c) { c.pgs_alpha = 6; }},
-      {"impedance", [](cfg& c) { c.impedance = 0.5; }},
-      {"pfac", [](cfg& c) { c.pfac = 2; }},
-      {"stiffening", [](cfg& c) { c.stiffening = 0.5; }},
-      {"coupling_damping", [](cfg& c) { c.coupling_damping = 0.1; }},
-      {"viscosity", [](cfg& c) { c.viscosity = "constant"; }},
-      {"cfl", [](cfg& c) { c.cfl = 0.5; }},
-      {"membrane_damping", [](cfg& c) { c.membrane_damping = 0.1; }},
-      {"history_every", [](cfg& c) { c.history_every = 0.004; }},
-      {"initial_speed", [](cfg& c) { c.initial_speed = 9; }},
-      {"payload_mass", [](cfg& c) { c.payload_mass = 50; }},
-      {"line_stiffness", [](cfg& c) { c.line_stiffness = 10; }},
-      {"modulus_scale", [](cfg& c) { c.modulus_scale = 10; }},
-      {"packed", [](cfg& c) { c.packed = "constructed"; }},
-      {"packed_parameter", [](cfg& c) { c.packed_parameter = 0.3; }},
-      {"box", [](cfg& c) {
-         c.box = "fixed";
-         c.fixed_fall = 5;
-       }},
-      {"box_width", [](cfg& c) { c.box_width = 6; }},
-      {"box_length", [](cfg& c) { c.box_length = 8; }},
-      {"box_ahead", [](cfg& c) { c.box_ahead = 2; }},
+  const change changes[] =
+      {
+          {"canopy", [](cfg& c) { c.canopy = "c9"; }},
+          {"fabric", [](cfg& c) { c.fabric = "mat509"; }},
+          {"cell", [](cfg& c) { c.cell = 0.3; }},
+          {"element", [](cfg& c) { c.element = 0.15; }},
+          {"growth", [](cfg& c) { c.growth = 1.5; }},
+          {"coupling", [](cfg& c) { c.coupling = "penalty"; }},
+          {"pgs_alpha", [](cfg& c) { c.pgs_alpha = 6; }},
+          {"impedance", [](cfg& c) { c.impedance = 0.5; }},
+          {"pfac", [](cfg& c) { c.pfac = 2; }},
+          {"stiffening", [](cfg& c) { c.stiffening = 0.5; }},
+          {"coupling_damping", [](cfg& c) { c.coupling_damping = 0.1; }},
+          {"viscosity", [](cfg& c) { c.viscosity = "constant"; }},
+          {"cfl", [](cfg& c) { c.cfl = 0.5; }},
+          {"membrane_damping", [](cfg& c) { c.membrane_damping = 0.1; }},
+          {"history_every", [](cfg& c) { c.history_every = 0.004; }},
+          {"initial_speed", [](cfg& c) { c.initial_speed = 9; }},
+          {"payload_mass", [](cfg& c) { c.payload_mass = 50; }},
+          {"line_stiffness", [](cfg& c) { c.line_stiffness = 10; }},
+          {"modulus_scale", [](cfg& c) { c.modulus_scale = 10; }},
+          {"packed", [](cfg& c) { c.packed = "constructed"; }},
+          {"packed_parameter", [](cfg& c) { c.packed_parameter = 0.3; }},
+          {"box",
+           [](cfg& c) {
+    c.box = "fixed";
+    c.fixed_fall = 5;
+           }},
+          {"box_width", [](cfg& c) { c.box_width = 6; }},
+          {"box_length", [](cfg& c) { c.box_length = 8; }},
+          {"box_ahead", [](cfg& c) { c.box_ahead = 2; }},
   };
   for (const change& ch : changes) {
     CAPTURE(ch.name);
@@ -239,38 +241,39 @@ TEST_CASE("drop extremes: 10x payload, 30 m/s release, 100x stiffer lines") {
     const char* name;
     double payload_mass, initial_speed, line_stiffness;
   };
-  for (const scene sc : {scene{"payload x10", 18.0, -1, 1}, scene{"release 30 m/s", -1, 30.0, 1},
-                         scene{"lines x100", -1, 8.0, 100}}) {
+  for (const scene sc :
+       {scene{"payload x10", 18.0, -1, 1}, scene{"release 30 m/s", -1, 30.0, 1}, scene{"lines x100", -1, 8.0, 100}}) {
     for (const char* coupling : {"penalty", "embedded"}) {
-    CAPTURE(coupling);
-    parafsi::scene::drop_config c;
-    c.resolution = "tiny";
-    c.coupling = coupling;
-    c.pgs_alpha = 0.0;  // auto
-    c.t_end = 0.25;
-    c.quiet = true;
-    c.out.clear();
-    c.payload_mass = sc.payload_mass;
-    c.initial_speed = sc.initial_speed;
-    c.line_stiffness = sc.line_stiffness;
-    try {
-      const auto r = parafsi::scene::run_drop(c);
-      const auto& e = r.history.back();
-      std::printf("extreme %-15s %-8s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
-                  sc.name, coupling, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);
-      CHECK(e.t == doctest::Approx(0.25).epsilon(1e-12));
-      for (const auto& row : r.history)
-        for (double v : row.values())
-          if (!std::isnan(v)) REQUIRE(std::isfinite(v));  // (drag coefficient is NaN at rest)
-      const double v0 = sc.initial_speed >= 0 ? sc.initial_speed : 0.0;
-      CHECK(e.speed < v0 + 9.81 * 0.25 + 1e-9);  // the air can only slow the fall (vertical release)
-      CHECK(r.summary.F_p > 0.0);
-      CHECK(std::isfinite(r.summary.F_p));
-    } catch (const parafsi::numerical_failure& err) {
-      // Allowed outcome: a clear stop naming the time.
-      MESSAGE(sc.name << " stopped: " << err.what());
-      CHECK(std::string(err.what()).find("t = ") != std::string::npos);
-    }
+      CAPTURE(coupling);
+      parafsi::scene::drop_config c;
+      c.resolution = "tiny";
+      c.coupling = coupling;
+      c.pgs_alpha = 0.0;  // auto
+      c.t_end = 0.25;
+      c.quiet = true;
+      c.out.clear();
+      c.payload_mass = sc.payload_mass;
+      c.initial_speed = sc.initial_speed;
+      c.line_stiffness = sc.line_stiffness;
+      try {
+        const auto r = parafsi::scene::run_drop(c);
+        const auto& e = r.history.back();
+        std::printf(
+            "extreme %-15s %-8s: t = %.3f, speed %.3f m/s, F_p %.2f N, D %.3f m, %ld steps, %.1f substeps/step\n",
+            sc.name, coupling, e.t, e.speed, r.summary.F_p, e.canopy_diameter, r.steps, r.substeps_per_step);
+        CHECK(e.t == doctest::Approx(0.25).epsilon(1e-12));
+        for (const auto& row : r.history)
+          for (double v : row.values())
+            if (!std::isnan(v)) REQUIRE(std::isfinite(v));  // (drag coefficient is NaN at rest)
+        const double v0 = sc.initial_speed >= 0 ? sc.initial_speed : 0.0;
+        CHECK(e.speed < v0 + 9.81 * 0.25 + 1e-9);  // the air can only slow the fall (vertical release)
+        CHECK(r.summary.F_p > 0.0);
+        CHECK(std::isfinite(r.summary.F_p));
+      } catch (const parafsi::numerical_failure& err) {
+        // Allowed outcome: a clear stop naming the time.
+        MESSAGE(sc.name << " stopped: " << err.what());
+        CHECK(std::string(err.what()).find("t = ") != std::string::npos);
+      }
     }
   }
 }

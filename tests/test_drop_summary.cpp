@@ -22,8 +22,8 @@ namespace {
 
 /// A synthetic drop: diameter rising as 1 − e^{−t/τ} with an overshoot bump at t_mo,
 /// a force pulse at t_p, speed relaxing to v_T, vertical descent unless told otherwise.
-std::vector<io::drop_history_row> synthetic(double t_end, double dt, double Ds, double v_T,
-                                            double tilt_deg = 0.0, double drift = 0.0, double swing_rate = 0.0) {
+std::vector<io::drop_history_row> synthetic(double t_end, double dt, double Ds, double v_T, double tilt_deg = 0.0,
+                                            double drift = 0.0, double swing_rate = 0.0) {
   std::vector<io::drop_history_row> h;
   for (int n = 0; n * dt <= t_end + 1e-12; ++n) {
     const double t = n * dt;

@@ -58,7 +58,8 @@ TEST_CASE("HLLC-LM with phi = 1 equals HLLC to round-off") {
   const flux::hllc h{};
   double worst = 0;
   for (double ms : {0.01, 0.3, 2.0})
-    for (const auto& s : random_samples(2000, ms)) worst = std::max(worst, rel(lm(s.L, s.R, s.n, g), h(s.L, s.R, s.n, g)));
+    for (const auto& s : random_samples(2000, ms))
+      worst = std::max(worst, rel(lm(s.L, s.R, s.n, g), h(s.L, s.R, s.n, g)));
   MESSAGE("max relative difference HLLC-LM(phi=1) vs HLLC = ", worst);
   CHECK(worst < 1e-13);
 }

@@ -26,7 +26,8 @@ TEST_CASE("free-stream preservation on a translating and rotating box") {
       for (index_t j = 0; j < 8; ++j)
         for (index_t i = 0; i < 10; ++i) {
           const auto w = s.primitive(i, j, k);
-          du = std::max(du, std::sqrt(std::pow(w.u.x - u0[0], 2) + std::pow(w.u.y - u0[1], 2) + std::pow(w.u.z - u0[2], 2)));
+          du = std::max(du, std::sqrt(std::pow(w.u.x - u0[0], 2) + std::pow(w.u.y - u0[1], 2) +
+                                      std::pow(w.u.z - u0[2], 2)));
           dp = std::max(dp, std::fabs(w.p - p0));
         }
     const double turned = std::acos(std::clamp((s.pose().R.trace() - 1) / 2, -1.0, 1.0));

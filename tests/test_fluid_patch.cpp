@@ -13,24 +13,26 @@ TEST_CASE("a patched wall plane seals one half of the box from the other") {
   const int n = 16;
   fluid::solver s{fluid::rectilinear_grid::uniform({n, 4, 4}, {0, 0, 0}, {1, 0.25, 0.25}),
                   boundary::set::all(boundary::slip_wall{}), flux::hllc_lm{}};
-  s.initialize([](const Eigen::Vector3d& x) { return x[0] < 0.5 ? prim{1.2, {0, 0, 0}, 101375.0} : prim{1.2, {0, 0, 0}, 101325.0}; });
+  s.initialize([](const Eigen::Vector3d& x) {
+    return x[0] < 0.5 ? prim{1.2, {0, 0, 0}, 101375.0} : prim{1.2, {0, 0, 0}, 101325.0};
+  });
   std::vector<fluid::patch_face> faces;
   for (index_t k = 0; k < 4; ++k)
     for (index_t j = 0; j < 4; ++j) faces.push_back({s.index(n / 2, j, k), 0});
   double impulse_on_wall = 0;
   int calls = 0, bad_context = 0;
   fluid::face_patches wall{faces, [&](const fluid::face_context& fc, fluid::cons<double>& lo, fluid::cons<double>& hi) {
-    // Reflecting wall on each side: only the pressure acts, no mass or energy crosses.
-    const double nx = fc.n.x;
-    lo = {0.0, {fc.L.p * nx, 0.0, 0.0}, 0.0};
-    hi = {0.0, {fc.R.p * nx, 0.0, 0.0}, 0.0};
-    impulse_on_wall += (fc.L.p - fc.R.p) * fc.area;
-    // The context names the stage and the list position: stage-major, list order.
-    const int expect = calls++;
-    if (fc.patch != std::size_t(expect % 16) || fc.stage != (expect / 16) % decltype(s)::stages ||
-        fc.high != faces[fc.patch].high)
-      ++bad_context;
-  }};
+                             // Reflecting wall on each side: only the pressure acts, no mass or energy crosses.
+                             const double nx = fc.n.x;
+                             lo = {0.0, {fc.L.p * nx, 0.0, 0.0}, 0.0};
+                             hi = {0.0, {fc.R.p * nx, 0.0, 0.0}, 0.0};
+                             impulse_on_wall += (fc.L.p - fc.R.p) * fc.area;
+                             // The context names the stage and the list position: stage-major, list order.
+                             const int expect = calls++;
+                             if (fc.patch != std::size_t(expect % 16) ||
+                                 fc.stage != (expect / 16) % decltype(s)::stages || fc.high != faces[fc.patch].high)
+                               ++bad_context;
+                           }};
   auto half_mass = [&](int side) {
     double m = 0;
     for (index_t k = 0; k < 4; ++k)
@@ -60,7 +62,8 @@ TEST_CASE("the identity patch reproduces the unpatched solution exactly") {
   };
   a.initialize(init);
   b.initialize(init);
-  fluid::face_patches identity{std::vector<fluid::patch_face>{{b.index(3, 2, 1), 0}, {b.index(5, 3, 2), 1},
+  fluid::face_patches identity{std::vector<fluid::patch_face>{{b.index(3, 2, 1), 0},
+                                                              {b.index(5, 3, 2), 1},
                                                               {b.index(7, 1, 2), 2}},
                                [](const fluid::face_context&, fluid::cons<double>&, fluid::cons<double>&) {}};
   for (int k = 0; k < 10; ++k) {

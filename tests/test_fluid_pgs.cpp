@@ -14,8 +14,8 @@ using namespace parafsi;
 namespace {
 struct pgs_run {
   long steps = 0;
-  double u_err = 0;   ///< L1 |u − u_exact| / L1 |u_exact|
-  double p_err = 0;   ///< L1 |(p_phys − p∞) − Δp_exact| / max Δp_exact
+  double u_err = 0;  ///< L1 |u − u_exact| / L1 |u_exact|
+  double p_err = 0;  ///< L1 |(p_phys − p∞) − Δp_exact| / max Δp_exact
 };
 
 // Physical Mach number `mach`, scaled by α: the scaled gas is the Gresho vortex at α M.

@@ -13,8 +13,8 @@ using namespace parafsi;
 using pft::prim;
 
 namespace {
-using inviscid_solver = fluid::solver<flux::hllc_lm, recon::muscl<limiter::van_leer>, turbulence::none,
-                                      viscosity::inviscid, frame::fixed>;
+using inviscid_solver =
+    fluid::solver<flux::hllc_lm, recon::muscl<limiter::van_leer>, turbulence::none, viscosity::inviscid, frame::fixed>;
 using les_solver = fluid::solver<flux::hllc_lm, recon::muscl<limiter::van_leer>, turbulence::smagorinsky,
                                  viscosity::constant, frame::fixed>;
 using ml_solver = fluid::solver<flux::hllc_lm, recon::muscl<limiter::van_leer>, turbulence::prandtl_mixing_length,
@@ -36,7 +36,9 @@ using deduced = decltype(fluid::solver{std::declval<fluid::rectilinear_grid>(), 
                                        std::declval<viscosity::constant>(), std::declval<turbulence::smagorinsky>()});
 static_assert(std::is_same_v<deduced, les_solver>);
 template <class... P>
-concept constructible = requires(P... p) { fluid::solver{fluid::rectilinear_grid{}, boundary::set{}, p...}; };
+concept constructible = requires(P... p) {
+  fluid::solver{fluid::rectilinear_grid{}, boundary::set{}, p...};
+};
 static_assert(constructible<flux::hllc, recon::first_order, time::ssp_rk3>);
 }  // namespace
 
@@ -62,10 +64,17 @@ TEST_CASE("bad input is rejected with a message naming the value") {
       CHECK(std::string(e.what()).find(needle) != std::string::npos);
     }
   };
-  expect([&] { fluid::solver s{grid, boundary::set::all(boundary::periodic{}).side(0, 1, boundary::slip_wall{})}; },
-         "periodic");
-  expect([&] { fluid::rectilinear_grid g(fluid::axis{{0.0, 0.5, 0.4, 1.0}}, fluid::axis::uniform(2, 0, 1),
-                                         fluid::axis::uniform(2, 0, 1)); }, "not increasing");
+  expect(
+      [&] {
+    fluid::solver s{grid, boundary::set::all(boundary::periodic{}).side(0, 1, boundary::slip_wall{})};
+      },
+      "periodic");
+  expect(
+      [&] {
+    fluid::rectilinear_grid g(fluid::axis{{0.0, 0.5, 0.4, 1.0}}, fluid::axis::uniform(2, 0, 1),
+                              fluid::axis::uniform(2, 0, 1));
+      },
+      "not increasing");
   expect([&] { fluid::axis::uniform(0, 0, 1); }, "at least one cell");
   fluid::solver s{grid, boundary::set::all(boundary::periodic{})};
   expect([&] { s.initialize([](const Eigen::Vector3d&) { return prim{-1.0, {0, 0, 0}, 1.0}; }); }, "density");
@@ -80,7 +89,9 @@ TEST_CASE("a blow-up stops with the cell, position and time") {
   auto bc = boundary::set::all(boundary::slip_wall{});
   bc.axis(0, boundary::outflow{});
   fluid::solver s{fluid::rectilinear_grid::uniform({100, 2, 2}, {0, 0, 0}, {1, 0.02, 0.02}), bc, flux::hllc{}};
-  s.initialize([](const Eigen::Vector3d& x) { return x[0] < 0.5 ? prim{1, {0, 0, 0}, 1000} : prim{1, {0, 0, 0}, 0.01}; });
+  s.initialize([](const Eigen::Vector3d& x) {
+    return x[0] < 0.5 ? prim{1, {0, 0, 0}, 1000} : prim{1, {0, 0, 0}, 0.01};
+  });
   const double dt = 20 * s.stable_dt(0.5);  // far above the CFL limit
   bool thrown = false;
   try {
@@ -107,7 +118,8 @@ TEST_CASE("conservation to round-off in a periodic box, and identical results fo
     s.set_threading(true);  // small grid: force the threaded phases
     s.initialize([](const Eigen::Vector3d& x) {
       const double k = 2 * std::numbers::pi;
-      return prim{1.0 + 0.1 * std::sin(k * x[0]), {0.3 * std::sin(k * x[1]), 0.2 * std::cos(k * x[2]), 0.1},
+      return prim{1.0 + 0.1 * std::sin(k * x[0]),
+                  {0.3 * std::sin(k * x[1]), 0.2 * std::cos(k * x[2]), 0.1},
                   1.0 + 0.1 * std::cos(k * x[0] + k * x[1])};
     });
     const auto t0 = s.totals();

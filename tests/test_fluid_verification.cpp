@@ -57,8 +57,10 @@ TEST_CASE("isentropic vortex: second-order convergence (observed order >= 1.8 on
   const double e2 = vortex_l1<flux::hllc_lm, R>(64, &t2);
   const double e3 = vortex_l1<flux::hllc_lm, R>(128, &t3);
   const double o1 = std::log2(e1 / e2), o2 = std::log2(e2 / e3);
-  std::printf("isentropic vortex (hllc_lm, MUSCL-MC): L1(rho) 32: %.3e (%.2fs)  64: %.3e (%.2fs)  128: %.3e (%.2fs)"
-              "  orders %.2f %.2f\n", e1, t1, e2, t2, e3, t3, o1, o2);
+  std::printf(
+      "isentropic vortex (hllc_lm, MUSCL-MC): L1(rho) 32: %.3e (%.2fs)  64: %.3e (%.2fs)  128: %.3e (%.2fs)"
+      "  orders %.2f %.2f\n",
+      e1, t1, e2, t2, e3, t3, o1, o2);
   CHECK(o2 >= 1.8);
   CHECK(o1 >= 1.5);
 }

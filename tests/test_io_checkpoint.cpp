@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,8 +65,8 @@ auto make_fluid(index_t nx = 12) {
   s.initialize([](const Eigen::Vector3d& x) {
     const double r2 = x.squaredNorm();
     return pf::fluid::prim<double>{1.18 * (1 + 0.05 * std::exp(-8 * r2)),
-                                    {20 * x.y() * std::exp(-4 * r2), -20 * x.x() * std::exp(-4 * r2), 3.0},
-                                    101325.0 * (1 + 0.03 * std::exp(-10 * r2))};
+                                   {20 * x.y() * std::exp(-4 * r2), -20 * x.x() * std::exp(-4 * r2), 3.0},
+                                   101325.0 * (1 + 0.03 * std::exp(-10 * r2))};
   });
   s.enable_sources();
   const index_t c = s.grid().index(3, 4, 2);
@@ -88,8 +88,7 @@ void fluid_steps(S& s, int n) {
 template <class S>
 void require_same_fluid(const S& a, const S& b) {
   const std::size_t L = pf::io::ckpt::soa_length(a.grid().total_cells());
-  for (std::size_t f = 0; f < 5; ++f)
-    CHECK(same_bits(a.conserved_storage().data(f), b.conserved_storage().data(f), L));
+  for (std::size_t f = 0; f < 5; ++f) CHECK(same_bits(a.conserved_storage().data(f), b.conserved_storage().data(f), L));
   CHECK(a.time() == b.time());
   CHECK(same_bits(a.pose().X.data(), b.pose().X.data(), 3));
   CHECK(same_bits(a.pose().R.data(), b.pose().R.data(), 9));
@@ -117,12 +116,13 @@ auto make_structure(bool extra_node = false) {
   }
   st::line_mesh lines;
   for (index_t corner : {index_t(0), index_t(3), index_t(12), index_t(15)}) lines.segments.push_back({corner, hang});
-  st::attachment body{st::rigid_body{st::rigid_body::cuboid(1.8, {0.2, 0.25, 0.15}), {0.5, 0.5, -0.1},
+  st::attachment body{st::rigid_body{st::rigid_body::cuboid(1.8, {0.2, 0.25, 0.15}),
+                                     {0.5, 0.5, -0.1},
                                      Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX())),
-                                     {0.05, 0, 0}, {0.3, -0.2, 0.5}}};
+                                     {0.05, 0, 0},
+                                     {0.3, -0.2, 0.5}}};
   body.attach(hang, {0.01, 0, 0.1});
-  st::assembly a{std::move(nd),
-                 st::membrane_tri{tm, st::material::fabric<>::isotropic(2e8, 0.3, 0.05, 1e-4), {0.05}},
+  st::assembly a{std::move(nd), st::membrane_tri{tm, st::material::fabric<>::isotropic(2e8, 0.3, 0.05, 1e-4), {0.05}},
                  st::cable{lines, st::material::cable{2e3, 0.01, 0.1, 0}}, std::move(body)};
   a.part<0>().set_pressure(30.0);
   a.integrator().mass_damping = 0.5;
@@ -247,7 +247,8 @@ TEST_CASE("checkpoint: an embedded-coupling stepper restored mid-way continues b
     CHECK(same_bits(ref.fluid().conserved_storage().data(f), again.fluid().conserved_storage().data(f), L));
   const auto& sa = ref.structure().node_set().data();
   const auto& sb = again.structure().node_set().data();
-  for (std::size_t f = 0; f < 6; ++f) CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
+  for (std::size_t f = 0; f < 6; ++f)
+    CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
 }
 
 TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-identically") {
@@ -265,7 +266,8 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
     as.integrator().gravity = {0, 0, 0};
     pf::coupling::penalty_options o;
     o.pfac = pfac;
-    return pf::explicit_stepper{std::move(fl), std::move(as), pf::coupling::penalty{pf::porosity::ergun{1e9, 1e5, 1e-4}, o}};
+    return pf::explicit_stepper{std::move(fl), std::move(as),
+                                pf::coupling::penalty{pf::porosity::ergun{1e9, 1e5, 1e-4}, o}};
   };
   auto ref = make();
   // Varying steps, so the restored stepper must know its previous substep.
@@ -290,14 +292,16 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
     CHECK(same_bits(ref.fluid().conserved_storage().data(f), again.fluid().conserved_storage().data(f), L));
   const auto& sa = ref.structure().node_set().data();
   const auto& sb = again.structure().node_set().data();
-  for (std::size_t f = 0; f < 6; ++f) CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
+  for (std::size_t f = 0; f < 6; ++f)
+    CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
   for (std::size_t c = 0; c < ref.coupling().points().size(); ++c)
     CHECK(ref.coupling().penetration(index_t(c)) == again.coupling().penetration(index_t(c)));
   CHECK(ref.coupling().diagnostics().coupling_energy == again.coupling().diagnostics().coupling_energy);
   // The coupling's settings are part of the scene: another PFAC is refused by name.
   auto stiffer = make(2.0);
   CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(p, stiffer),
-                       doctest::Contains("the penalty factor PFAC is 1 in the file but 2 here"), pf::io::checkpoint_error);
+                       doctest::Contains("the penalty factor PFAC is 1 in the file but 2 here"),
+                       pf::io::checkpoint_error);
 }
 
 TEST_CASE("checkpoint: truncated, corrupted, foreign and mismatched files are refused with clear messages") {
@@ -350,8 +354,8 @@ TEST_CASE("checkpoint: truncated, corrupted, foreign and mismatched files are re
   const fs::path fluid_only = scratch("fluid_only.ckpt");
   pf::io::save_checkpoint(fluid_only, s);
   auto a2 = make_structure();
-  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(fluid_only, a2), doctest::Contains("has no section 'structure' (it holds: fluid)"),
-                       pf::io::checkpoint_error);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(fluid_only, a2),
+                       doctest::Contains("has no section 'structure' (it holds: fluid)"), pf::io::checkpoint_error);
   CHECK(unchanged());
 
   // And the good file still loads.
@@ -376,9 +380,11 @@ TEST_CASE("checkpoint: format version 1 is refused naming both versions") {
   write_bytes(v1, b);
   auto fresh = make_fluid();
   CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(v1, fresh),
-                       doctest::Contains("checkpoint format version 1 (entries by position); this build reads version 2"),
+                       doctest::Contains(
+                           "checkpoint format version 1 (entries by position); this build reads version 2"),
                        pf::io::checkpoint_error);
-  CHECK_THROWS_WITH_AS(pf::io::read_checkpoint_info(v1), doctest::Contains("format version 1"), pf::io::checkpoint_error);
+  CHECK_THROWS_WITH_AS(pf::io::read_checkpoint_info(v1), doctest::Contains("format version 1"),
+                       pf::io::checkpoint_error);
   CHECK(fresh.time() == 0.0);
 }
 
@@ -406,8 +412,8 @@ TEST_CASE("checkpoint: fields are stored by their tag names; another name is ref
                        pf::io::checkpoint_error);
   write_bytes(bad, rename_entry(good, "node.vy", "node.VY"));
   auto a2 = make_structure();
-  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(bad, a2), doctest::Contains("expected entry 'node.vy' but found 'node.VY'"),
-                       pf::io::checkpoint_error);
+  CHECK_THROWS_WITH_AS(pf::io::load_checkpoint(bad, a2),
+                       doctest::Contains("expected entry 'node.vy' but found 'node.VY'"), pf::io::checkpoint_error);
   // The untouched file loads, and the restored fluid and structure clocks equal the saved ones.
   auto f3 = make_fluid();
   auto a3 = make_structure();
@@ -485,8 +491,8 @@ TEST_CASE("checkpoint: a quad membrane with a pinned edge and a pressure load co
       }
     for (int j = 0; j + 1 < n; ++j)
       for (int i = 0; i + 1 < n; ++i)
-        qm.quads.push_back({index_t(j * n + i), index_t(j * n + i + 1), index_t((j + 1) * n + i + 1),
-                            index_t((j + 1) * n + i)});
+        qm.quads.push_back(
+            {index_t(j * n + i), index_t(j * n + i + 1), index_t((j + 1) * n + i + 1), index_t((j + 1) * n + i)});
     for (int i = 0; i < n; ++i) nd.pin(i);
     st::quad_options o;
     o.damping_ratio = 0.05;

@@ -44,7 +44,7 @@ TEST_CASE("csv_writer: header once, rows of doubles that round-trip, column coun
   char k1, k2;
   std::istringstream(l[1]) >> a >> k1 >> b >> k2 >> c;
   CHECK(a == 0.0);
-  CHECK(b == 0.1);            // 17 digits: exact round-trip
+  CHECK(b == 0.1);  // 17 digits: exact round-trip
   CHECK(c == 1.0 / 3.0);
   CHECK(l[2] == "1e-300,-2.5,nan");
 }
@@ -88,8 +88,8 @@ TEST_CASE("csv_writer: flush policies") {
 // file, at the first flushed row, not a silent success.
 TEST_CASE("csv_writer: a failed write throws naming the file") {
   if (!fs::exists("/dev/full")) return;
-  CHECK_THROWS_WITH_AS(io::csv_writer("/dev/full", {"t"}).row({1.0}),
-                       doctest::Contains("write to /dev/full failed"), invalid_input);
+  CHECK_THROWS_WITH_AS(io::csv_writer("/dev/full", {"t"}).row({1.0}), doctest::Contains("write to /dev/full failed"),
+                       invalid_input);
 }
 
 TEST_CASE("progress: rate-limited lines with steps/s, ETA and extra fields") {

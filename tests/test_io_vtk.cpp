@@ -57,7 +57,9 @@ struct node {
 };
 std::unique_ptr<node> parse_xml(const std::string& s) {
   std::size_t i = 0;
-  auto fail = [&](const char* what) { throw std::runtime_error(std::string("xml: ") + what + " at " + std::to_string(i)); };
+  auto fail = [&](const char* what) {
+    throw std::runtime_error(std::string("xml: ") + what + " at " + std::to_string(i));
+  };
   auto root = std::make_unique<node>();
   root->name = "#document";
   std::vector<node*> stack{root.get()};
@@ -86,8 +88,16 @@ std::unique_ptr<node> parse_xml(const std::string& s) {
       for (;;) {
         while (i < s.size() && std::isspace((unsigned char)s[i])) ++i;
         if (i >= s.size()) fail("unterminated tag");
-        if (s[i] == '/') { self = true; if (s[i + 1] != '>') fail("bad />"); i += 2; break; }
-        if (s[i] == '>') { ++i; break; }
+        if (s[i] == '/') {
+          self = true;
+          if (s[i + 1] != '>') fail("bad />");
+          i += 2;
+          break;
+        }
+        if (s[i] == '>') {
+          ++i;
+          break;
+        }
         std::string k;
         while (i < s.size() && s[i] != '=' && !std::isspace((unsigned char)s[i])) k += s[i++];
         if (s[i] != '=' || s[i + 1] != '"') fail("attribute without quoted value");
@@ -181,7 +191,8 @@ auto small_assembly() {
   st::attachment body{st::rigid_body{st::rigid_body::cuboid(2.0, {0.2, 0.2, 0.2}), {0.5, 0.5, -0.1}}};
   body.attach(hang, {0, 0, 0.1});
   st::assembly a{std::move(nd), st::membrane_tri{m, st::material::fabric<>::isotropic(1e8, 0.3, 0.05, 1e-4)},
-                 st::cable{st::line_mesh{{{n0, hang}, {n2, hang}}, {1.1, 1.1}}, st::material::cable{1e4, 0.01, 0.05, 0}},
+                 st::cable{st::line_mesh{{{n0, hang}, {n2, hang}}, {1.1, 1.1}},
+                           st::material::cable{1e4, 0.01, 0.05, 0}},
                  std::move(body)};
   a.finalize();
   return a;
@@ -261,7 +272,8 @@ TEST_CASE("vtu: a failed write throws io::write_error naming the file") {
   CHECK_FALSE(fs::exists(p));
 }
 
-TEST_CASE("vts: inertial corner points on a turned box, cell values round-trip, vorticity of solid rotation = 2 Omega") {
+TEST_CASE(
+    "vts: inertial corner points on a turned box, cell values round-trip, vorticity of solid rotation = 2 Omega") {
   const auto grid = fluid::rectilinear_grid(fluid::axis::refined(-1.0, 1.0, -0.3, 0.3, 0.1, 1.2),
                                             fluid::axis::uniform(6, -0.6, 0.6), fluid::axis::uniform(5, 0.0, 1.0));
   fluid::solver s{grid, boundary::set::all(boundary::far_field{})};

@@ -54,7 +54,8 @@ TEST_CASE("canopy: triangles counter-clockwise, good quality, every triangle in 
   for (std::size_t e = 0; e < c.triangles.size(); ++e) {
     const auto& t = c.triangles[e];
     const auto& X = c.positions;
-    const double z = (X[std::size_t(t[1])] - X[std::size_t(t[0])]).cross(X[std::size_t(t[2])] - X[std::size_t(t[0])]).z();
+    const double z =
+        (X[std::size_t(t[1])] - X[std::size_t(t[0])]).cross(X[std::size_t(t[2])] - X[std::size_t(t[0])]).z();
     REQUIRE(z > 0);
     qmin = std::min(qmin, tri_quality(c, t));
     // Warp = unit vector along the gore centreline; the triangle's centroid is inside its gore.
@@ -144,7 +145,8 @@ TEST_CASE("canopy: tags are consistent") {
     const unsigned t = c.node_tag[std::size_t(i)];
     CHECK(bool(t & md::canopy_tag::skirt) == bool(skirt.count(i)));
     CHECK(bool(t & md::canopy_tag::vent) == bool(vent.count(i)));
-    if (t & md::canopy_tag::skirt) CHECK(std::abs(c.positions[std::size_t(i)].norm() * std::cos(0.0)) <= c.skirt_radius + 1e-12);
+    if (t & md::canopy_tag::skirt)
+      CHECK(std::abs(c.positions[std::size_t(i)].norm() * std::cos(0.0)) <= c.skirt_radius + 1e-12);
     n_attach += bool(t & md::canopy_tag::line_attachment);
   }
   CHECK(n_attach == N);

@@ -104,9 +104,8 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     CHECK(s.payload.hanging_point.z() == doctest::Approx(0.05));
     CHECK(s.payload.inertia_diagonal.x() == doctest::Approx(1.8 / 12 * (0.15 * 0.15 + 0.1 * 0.1)));
     // Confluence distance from the skirt plane: sqrt(Ls^2 - rho^2), rho the packed skirt corner radius.
-    const double rho = (s.frame.conjugate() * (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset))
-                           .head<2>()
-                           .norm();
+    const double rho =
+        (s.frame.conjugate() * (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset)).head<2>().norm();
     const double zs = (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset).z();
     const double zc = (s.positions[std::size_t(s.suspension.confluence)] - s.offset).z();
     CHECK(zs - zc == doctest::Approx(std::sqrt(Ls * Ls - rho * rho)).epsilon(1e-12));
@@ -142,10 +141,11 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     for (const auto& cs : s.cables) CHECK(cs.rest_length.size() == cs.segments.size());
     // Packed radius scale in the scene.
     if (shape.kind == md::packed_kind::reduced_radius) CHECK(rho == doctest::Approx(0.2 * Rs).epsilon(1e-12));
-    std::printf("paper scene (%s): %ld nodes, %zu triangles, cloth %.4f kg, total %.4f kg, line EA %.0f N, "
-                "confluence %.4f m below skirt\n",
-                shape.name(), s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(),
-                L.material.EA(), zs - zc);
+    std::printf(
+        "paper scene (%s): %ld nodes, %zu triangles, cloth %.4f kg, total %.4f kg, line EA %.0f N, "
+        "confluence %.4f m below skirt\n",
+        shape.name(), s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(), L.material.EA(),
+        zs - zc);
   }
 }
 
@@ -175,9 +175,10 @@ TEST_CASE("C-9 variant: 28 gores, 28 ft, 13.4 m/s") {
   CHECK(s.cable(md::cable_kind::suspension_line).total_rest_length() == doctest::Approx(28 * 8.5344).epsilon(1e-12));
   CHECK(s.cable(md::cable_kind::riser).total_rest_length() == doctest::Approx(0.08 * 8.5344).epsilon(1e-12));
   CHECK(s.fabric.name == "c9_mil_c_7020");
-  std::printf("C-9 scene: %ld nodes, %zu triangles, cloth %.3f kg, total %.3f kg, fabric E*t %.0f N/m, line EA %.0f N\n",
-              s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(), s.moduli.stiffness(),
-              s.cable(md::cable_kind::suspension_line).material.EA());
+  std::printf(
+      "C-9 scene: %ld nodes, %zu triangles, cloth %.3f kg, total %.3f kg, fabric E*t %.0f N/m, line EA %.0f N\n",
+      s.node_count(), s.triangles.size(), s.canopy_cloth_mass(), s.total_mass(), s.moduli.stiffness(),
+      s.cable(md::cable_kind::suspension_line).material.EA());
 }
 
 TEST_CASE("scene: bad parameters are rejected with the value named") {
@@ -194,12 +195,15 @@ TEST_CASE("scene: bad parameters are rejected with the value named") {
                        doctest::Contains("mass must be > 0, got -2"), pf::invalid_input);
   CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line_length_ratio = -1; })),
                        doctest::Contains("got -1"), pf::invalid_input);
-  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.shape = md::packed_shape::constructed(); p.line_length_ratio = 0.5; })),
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) {
+                         p.shape = md::packed_shape::constructed();
+                         p.line_length_ratio = 0.5;
+                       })),
                        doctest::Contains("shorter than the attachment radius"), pf::invalid_input);
   CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.riser_ratio = 0; })),
                        doctest::Contains("riser ratio Lr/Ls must be > 0, got 0"), pf::invalid_input);
-  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line_segments = 0; })),
-                       doctest::Contains("got 0"), pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line_segments = 0; })), doctest::Contains("got 0"),
+                       pf::invalid_input);
   CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.fabric = "silk"; })),
                        doctest::Contains("unknown fabric 'silk'"), pf::invalid_input);
   CHECK_THROWS_WITH_AS(md::build_drop_scene(bad([](auto& p) { p.line.elongation = -0.25; })),

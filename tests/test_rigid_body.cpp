@@ -12,11 +12,11 @@
 #include <parafsi/structure/free_top.hpp>
 #include <parafsi/structure/rigid_body.hpp>
 
+using Eigen::Quaterniond;
+using Eigen::Vector3d;
 using parafsi::structure::free_top_period;
 using parafsi::structure::rigid_body;
 using parafsi::structure::rigid_body_properties;
-using Eigen::Quaterniond;
-using Eigen::Vector3d;
 
 namespace {
 
@@ -57,7 +57,9 @@ double measured_period(const Vector3d& inertia, const Vector3d& omega, int axis,
   return (up.back() - up.front()) / static_cast<double>(up.size() - 1);
 }
 
-bool bitwise_equal(const Vector3d& a, const Vector3d& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0; }
+bool bitwise_equal(const Vector3d& a, const Vector3d& b) {
+  return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0;
+}
 
 }  // namespace
 
@@ -67,8 +69,8 @@ TEST_CASE("free asymmetric top: |L| to round-off, energy to 1e-6 over 1e4 steps"
                   Vector3d(0.5, 0, -1), Vector3d(0.3, 1.0, 0.2));
   const Vector3d L0 = body.spin_angular_momentum_world(), H0 = body.angular_momentum_world();
   const drift d = run_free(body, 1e-3, 10000);
-  std::printf("free top, 1e4 steps: energy drift %.3e, |L| drift %.3e, | |q|-1 | %.3e\n", d.energy,
-              d.angular_momentum, d.quaternion);
+  std::printf("free top, 1e4 steps: energy drift %.3e, |L| drift %.3e, | |q|-1 | %.3e\n", d.energy, d.angular_momentum,
+              d.quaternion);
   CHECK(d.energy < 1e-6);
   CHECK(d.angular_momentum < 1e-14);
   CHECK(d.quaternion < 1e-15);
@@ -83,11 +85,11 @@ TEST_CASE("free asymmetric top: |L| to round-off, energy to 1e-6 over 1e4 steps"
 TEST_CASE("free top with a full (non-diagonal) inertia tensor conserves the invariants") {
   rigid_body body(rigid_body::cuboid(1.8, Vector3d(0.3, 0.2, 0.15)), Vector3d::Zero(), Quaterniond::Identity(),
                   Vector3d::Zero(), Vector3d(2.0, -5.0, 3.0));
-  body.add_attached_mass(0.2, Vector3d(0.15, 0.1, 0.075));   // off-axis: full tensor
+  body.add_attached_mass(0.2, Vector3d(0.15, 0.1, 0.075));  // off-axis: full tensor
   body.add_attached_mass(0.05, Vector3d(-0.1, 0.05, 0.0));
   const Eigen::Matrix3d J = body.inertia_body();
   REQUIRE(std::abs(J(0, 1)) > 1e-4);
-  const drift d = run_free(body, 1e-4, 10000);   // |ω|Δt ≈ 6e-4
+  const drift d = run_free(body, 1e-4, 10000);  // |ω|Δt ≈ 6e-4
   std::printf("full-tensor free top: energy drift %.3e, |L| drift %.3e\n", d.energy, d.angular_momentum);
   CHECK(d.energy < 1e-6);
   CHECK(d.angular_momentum < 1e-14);
@@ -127,18 +129,19 @@ TEST_CASE("intermediate-axis flip period within 1 % of the Jacobi elliptic close
     const double T1 = measured_period(I, rc.omega, 1, 2e-3, rc.t_end);
     const double T2 = measured_period(I, rc.omega, 1, 1e-3, rc.t_end);
     const double e1 = std::abs(T1 - T_exact) / T_exact, e2 = std::abs(T2 - T_exact) / T_exact;
-    std::printf("flip period: omega=(%g,%g,%g) closed form %.9f s, measured %.9f s (dt=2e-3, err %.2e), "
-                "%.9f s (dt=1e-3, err %.2e), observed order %.2f\n",
-                rc.omega.x(), rc.omega.y(), rc.omega.z(), T_exact, T1, e1, T2, e2, std::log2(e1 / e2));
-    CHECK(e2 < 1e-2);   // the contract
-    CHECK(e2 < 1e-6);   // what a second-order method gives at |ω|Δt = 1e-3
+    std::printf(
+        "flip period: omega=(%g,%g,%g) closed form %.9f s, measured %.9f s (dt=2e-3, err %.2e), "
+        "%.9f s (dt=1e-3, err %.2e), observed order %.2f\n",
+        rc.omega.x(), rc.omega.y(), rc.omega.z(), T_exact, T1, e1, T2, e2, std::log2(e1 / e2));
+    CHECK(e2 < 1e-2);  // the contract
+    CHECK(e2 < 1e-6);  // what a second-order method gives at |ω|Δt = 1e-3
     CHECK(std::log2(e1 / e2) == doctest::Approx(2.0).epsilon(0.15));
   }
 }
 
 TEST_CASE("quaternion norm stays 1 to round-off over 1e6 steps") {
-  rigid_body body({1.0, Vector3d(1, 2, 3)}, Vector3d::Zero(), Quaterniond(0.3, 0.4, 0.5, 0.6),
-                  Vector3d::Zero(), Vector3d(3.0, 10.0, 1.0));
+  rigid_body body({1.0, Vector3d(1, 2, 3)}, Vector3d::Zero(), Quaterniond(0.3, 0.4, 0.5, 0.6), Vector3d::Zero(),
+                  Vector3d(3.0, 10.0, 1.0));
   double worst = 0;
   for (long n = 0; n < 1000000; ++n) {
     body.step(1e-4);
@@ -151,11 +154,10 @@ TEST_CASE("quaternion norm stays 1 to round-off over 1e6 steps") {
 }
 
 TEST_CASE("100 rad/s spin runs stably") {
-  const Vector3d I(0.1, 0.2, 0.25);   // a payload-like box
+  const Vector3d I(0.1, 0.2, 0.25);  // a payload-like box
   SUBCASE("tumbling about the intermediate axis at the structure's time step") {
-    rigid_body body({1.8, I}, Vector3d::Zero(), Quaterniond::Identity(), Vector3d::Zero(),
-                    Vector3d(1.0, 100.0, 1.0));
-    const drift d = run_free(body, 1e-5, 10000);   // |ω|Δt = 1e-3
+    rigid_body body({1.8, I}, Vector3d::Zero(), Quaterniond::Identity(), Vector3d::Zero(), Vector3d(1.0, 100.0, 1.0));
+    const drift d = run_free(body, 1e-5, 10000);  // |ω|Δt = 1e-3
     std::printf("100 rad/s, dt=1e-5: energy drift %.3e, |L| drift %.3e\n", d.energy, d.angular_momentum);
     CHECK(d.energy < 1e-6);
     CHECK(d.angular_momentum < 1e-14);
@@ -175,7 +177,7 @@ TEST_CASE("100 rad/s spin runs stably") {
     }
     std::printf("100 rad/s, dt=critical_dt: energy error first 10%% %.3e, rest %.3e\n", max_first, max_last);
     CHECK(max_last < 1e-2);
-    CHECK(max_last < 1.5 * max_first + 1e-12);   // bounded oscillation, no secular growth
+    CHECK(max_last < 1.5 * max_first + 1e-12);  // bounded oscillation, no secular growth
     CHECK(std::abs(body.attitude().norm() - 1.0) < 1e-15);
     const double T_exact = free_top_period(I, w0);
     const double T = measured_period(I, w0, 1, dt, 20 * T_exact);
@@ -184,8 +186,7 @@ TEST_CASE("100 rad/s spin runs stably") {
     CHECK(std::abs(T - T_exact) < 1e-2 * T_exact);
   }
   SUBCASE("a step far beyond the limit is refused with a message, not a silent wrong answer") {
-    rigid_body body({1.8, I}, Vector3d::Zero(), Quaterniond::Identity(), Vector3d::Zero(),
-                    Vector3d(30.0, 100.0, 20.0));
+    rigid_body body({1.8, I}, Vector3d::Zero(), Quaterniond::Identity(), Vector3d::Zero(), Vector3d(30.0, 100.0, 20.0));
     CHECK_THROWS_AS(body.step(0.05), parafsi::numerical_failure);
   }
 }
@@ -230,10 +231,9 @@ TEST_CASE("heavy symmetric top: steady horizontal precession rate Ω = ℓW/(J3 
   // With the axis horizontal the steady precession is exact: Ω = ℓ W / (J3 ω3).
   const double J1 = 0.05, J3 = 0.08, ell = 0.1, W = 9.81, w3 = 60.0;
   const double Omega = ell * W / (J3 * w3);
-  const Quaterniond q0(Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitY()));   // body z → world x
+  const Quaterniond q0(Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitY()));  // body z → world x
   const Vector3d omega_world = w3 * Vector3d::UnitX() + Omega * Vector3d::UnitZ();
-  rigid_body body({1.0, Vector3d(J1, J1, J3)}, Vector3d::Zero(), q0, Vector3d::Zero(),
-                  q0.conjugate() * omega_world);
+  rigid_body body({1.0, Vector3d(J1, J1, J3)}, Vector3d::Zero(), q0, Vector3d::Zero(), q0.conjugate() * omega_world);
   const double dt = 1e-4, t_end = 5.0;
   double max_tilt = 0, phi_prev = 0, phi = 0;
   for (long n = 0; n < static_cast<long>(t_end / dt); ++n) {
@@ -350,7 +350,7 @@ TEST_CASE("checkpoint: state()/set_state() restarts bit for bit") {
       b.clear_loads();
       b.add_force(b.mass() * Vector3d(0, 0, -9.81));
       b.add_force_at(Vector3d(0.1 * std::sin(b.time()), 0.0, 17.0), Vector3d(0, 0, 0.075));
-      b.step(i % 3 == 0 ? 1e-4 : 1.3e-4);   // variable steps too
+      b.step(i % 3 == 0 ? 1e-4 : 1.3e-4);  // variable steps too
     }
   };
   rigid_body a = make();
@@ -382,11 +382,11 @@ TEST_CASE("bad input is rejected with the offending value named") {
   CHECK_THROWS_AS(rigid_body({1.0, Vector3d(0, 1, 1)}, Vector3d::Zero()), invalid_input);
   CHECK_THROWS_WITH_AS(rigid_body({1.0, Vector3d(1, 1, 3)}, Vector3d::Zero()),
                        doctest::Contains("triangle inequality: Iz = 3"), invalid_input);
-  CHECK_NOTHROW(rigid_body({1.0, Vector3d(1, 2, 3)}, Vector3d::Zero()));   // a lamina: I3 = I1 + I2
+  CHECK_NOTHROW(rigid_body({1.0, Vector3d(1, 2, 3)}, Vector3d::Zero()));  // a lamina: I3 = I1 + I2
   CHECK_THROWS_AS(rigid_body({1.0, I}, Vector3d(0, std::nan(""), 0)), invalid_input);
   CHECK_THROWS_AS(rigid_body({1.0, I}, Vector3d::Zero(), Quaterniond(0, 0, 0, 0)), invalid_input);
-  CHECK_THROWS_WITH_AS(rigid_body::cuboid(1.0, Vector3d(0.1, 0.0, 0.1)), doctest::Contains("edge length along y must be positive, got 0"),
-                       invalid_input);
+  CHECK_THROWS_WITH_AS(rigid_body::cuboid(1.0, Vector3d(0.1, 0.0, 0.1)),
+                       doctest::Contains("edge length along y must be positive, got 0"), invalid_input);
   rigid_body body({1.0, I}, Vector3d::Zero());
   CHECK_THROWS_WITH_AS(body.step(0.0), doctest::Contains("time step must be positive, got 0"), invalid_input);
   CHECK_THROWS_AS(body.step(std::nan("")), invalid_input);
@@ -396,7 +396,7 @@ TEST_CASE("bad input is rejected with the offending value named") {
   CHECK_THROWS_WITH_AS(body.step(1e-3), doctest::Contains("non-finite load"), numerical_failure);
   body.clear_loads();
   body.add_force(Vector3d(1e308, 0, 0));
-  body.step(1e-3);   // finite so far
+  body.step(1e-3);  // finite so far
   CHECK_THROWS_WITH_AS(for (int i = 0; i < 10; ++i) body.step(1.0), doctest::Contains("state became non-finite"),
                        numerical_failure);
 }

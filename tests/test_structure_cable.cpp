@@ -63,7 +63,11 @@ TEST_CASE("a mass on a cable oscillates at sqrt(EA/(L m))") {
     const double u = a.node_set().position(1).x() - x_eq;
     if (prev < 0 && u >= 0) {
       const double tc = a.time() - dt * u / (u - prev);
-      if (first < 0) first = tc; else { last = tc; ++crossings; }
+      if (first < 0) first = tc;
+      else {
+        last = tc;
+        ++crossings;
+      }
     }
     prev = u;
   }
@@ -91,7 +95,7 @@ TEST_CASE("slack to taut snap: stable, peak tension v0 sqrt(k M), energy conserv
   const double Tpeak = v0 * std::sqrt(k * M);
   std::printf("snap: peak tension %.6e N, elastic collision %.6e N, max energy error %.3e\n", Tmax, Tpeak, drift);
   CHECK(Tmax == doctest::Approx(Tpeak).epsilon(2e-3));
-  CHECK(drift < 2e-2);  // bounded: the kink at L = L0 costs O(Δt) per snap
+  CHECK(drift < 2e-2);                      // bounded: the kink at L = L0 costs O(Δt) per snap
   CHECK(a.node_set().velocity(1).x() < 0);  // it bounced back
 }
 
@@ -106,7 +110,10 @@ TEST_CASE("hanging chain matches the catenary within 1 % of the span") {
   nd.pin(0);
   nd.pin(N);
   st::line_mesh lm;
-  for (int i = 0; i < N; ++i) { lm.segments.push_back({i, i + 1}); lm.rest_length.push_back(L / N); }
+  for (int i = 0; i < N; ++i) {
+    lm.segments.push_back({i, i + 1});
+    lm.rest_length.push_back(L / N);
+  }
   st::assembly c{std::move(nd), st::cable{lm, st::material::cable{1e4, 0.1, 0.2, 0.0}}};
   const st::reference::catenary cat(S, L);
   c.integrator().mass_damping = 2 * std::sqrt(9.81 / cat.sag());
@@ -140,7 +147,10 @@ TEST_CASE("relax refuses a run whose stable step makes t_max unreachable, and st
     nd.pin(0);
     nd.pin(N);
     st::line_mesh lm;
-    for (int i = 0; i < N; ++i) { lm.segments.push_back({i, i + 1}); lm.rest_length.push_back(1.2 / N); }
+    for (int i = 0; i < N; ++i) {
+      lm.segments.push_back({i, i + 1});
+      lm.rest_length.push_back(1.2 / N);
+    }
     return st::assembly{std::move(nd), st::cable{lm, st::material::cable{EA, 0.1, 0.2, 0.0}}};
   };
   auto stiff = chain(1e300);
@@ -188,8 +198,10 @@ TEST_CASE("steel wire lines on a light fabric run stably with the computed subst
   long m = 0;
   while (s.time() < 0.05) m = std::max(m, s.advance(dt_fluid));
   const auto& E = s.energy();
-  std::printf("steel wire: stable dt %.3e s, %ld substeps per fluid step, K %.3e U %.3e D %.3e W %.3e, "
-              "balance %.3e\n", s.stable_dt(), m, E.kinetic, E.strain, E.damping, E.external, E.balance());
+  std::printf(
+      "steel wire: stable dt %.3e s, %ld substeps per fluid step, K %.3e U %.3e D %.3e W %.3e, "
+      "balance %.3e\n",
+      s.stable_dt(), m, E.kinetic, E.strain, E.damping, E.external, E.balance());
   CHECK(m >= 5);  // the wires, not the fabric, set the step
   CHECK(s.stable_dt() < 0.2 * 0.9 * s.part<0>().critical_dt(s.node_set()));
   CHECK(std::abs(E.balance()) < 0.05 * E.external);

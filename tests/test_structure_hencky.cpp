@@ -22,8 +22,8 @@ TEST_CASE("Hencky reference solver reproduces the published constants") {
   // small computational error (corrected by Chien 1948), so agreement is to ~1 %.
   const auto r = st::reference::hencky(0.25);
   const double s0 = r.s0 * std::cbrt(1.0 / 8.0);
-  std::printf("Hencky nu=0.25: f = %.5f (published 0.662), sigma0 coefficient %.5f (published 0.423)\n",
-              r.coefficient, s0);
+  std::printf("Hencky nu=0.25: f = %.5f (published 0.662), sigma0 coefficient %.5f (published 0.423)\n", r.coefficient,
+              s0);
   CHECK(r.coefficient == doctest::Approx(0.662).epsilon(0.01));
   CHECK(s0 == doctest::Approx(0.423).epsilon(0.01));
   std::printf("Hencky nu=0.3: f = %.5f\n", st::reference::hencky(0.3).coefficient);
@@ -39,13 +39,15 @@ TEST_CASE("clamped circular membrane: centre deflection within 3 % of Hencky, se
   double w[3];
   for (int k = 0; k < 3; ++k) {
     w[k] = hc.tri_deflection(rings[k]);
-    std::printf("Hencky: N = %2d (%4d triangles)  w0 = %.8e m  error %+.3e\n", rings[k], 6 * rings[k] * rings[k],
-                w[k], w[k] / w_ref - 1);
+    std::printf("Hencky: N = %2d (%4d triangles)  w0 = %.8e m  error %+.3e\n", rings[k], 6 * rings[k] * rings[k], w[k],
+                w[k] / w_ref - 1);
   }
   const double order = std::log2((w[0] - w[1]) / (w[1] - w[2]));
   const double w_extrap = w[2] + (w[2] - w[1]) / (std::pow(2.0, order) - 1);
-  std::printf("Hencky: observed order %.2f, extrapolated w0 = %.8e m (%+.3e vs Hencky; geometrically exact "
-              "model with follower pressure vs Föppl theory)\n", order, w_extrap, w_extrap / w_ref - 1);
+  std::printf(
+      "Hencky: observed order %.2f, extrapolated w0 = %.8e m (%+.3e vs Hencky; geometrically exact "
+      "model with follower pressure vs Föppl theory)\n",
+      order, w_extrap, w_extrap / w_ref - 1);
   CHECK(std::abs(w[2] / w_ref - 1) < 0.03);
   CHECK(std::abs(w[2] / w_ref - 1) < 0.003);  // in fact much closer
   CHECK(order > 1.5);

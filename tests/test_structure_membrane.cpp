@@ -19,10 +19,10 @@
 #include "membrane_rig.hpp"
 
 namespace st = parafsi::structure;
-using parafsi::index_t;
 using mrig::rig;
 using mrig::rotation;
 using mrig::square_mesh;
+using parafsi::index_t;
 
 TEST_CASE("membrane_tri patch test: a uniform strain is reproduced exactly in every element") {
   std::vector<Eigen::Vector3d> X;
@@ -96,7 +96,7 @@ TEST_CASE("orthotropic law reproduces the warp, weft, shear and bias moduli") {
   const double sig = 1e5, c2 = 0.5;
   const double e11 = sig * (c2 / E1 - nu12 / E1 * c2), e22 = sig * (c2 / E2 - nu12 / E1 * c2), g12 = sig * c2 / G12;
   s = impose(e11, e22, 0.5 * g12);
-  const double Sn = 0.5 * (s[3] + s[4]) + s[5];  // n·S·n, n = (1,1)/√2
+  const double Sn = 0.5 * (s[3] + s[4]) + s[5];                        // n·S·n, n = (1,1)/√2
   const double Et = 0.5 * (s[0] + s[1]) + s[2] * 1.0 * 0.5 * 2 * 0.5;  // n·E·n
   const double E45 = 4.0 / (1 / E1 + 1 / E2 + 1 / G12 - 2 * nu12 / E1);
   std::printf("moduli: warp %.6e weft %.6e bias apparent %.6e (closed form %.6e)\n", E1, E2, Sn / Et, E45);
@@ -158,10 +158,16 @@ TEST_CASE("wrinkling: a sheet pushed together stays stable and carries ~no compr
   s.track_energy();
   const double dt = s.stable_dt();
   long n = 0;
-  while (s.time() < 0.1) { s.step(dt); ++n; }  // 10 % compression
+  while (s.time() < 0.1) {
+    s.step(dt);
+    ++n;
+  }  // 10 % compression
   for (index_t i : right) s.node_set().set_velocity(i, Eigen::Vector3d::Zero());
   const double t1 = s.time();
-  while (s.time() < t1 + 0.05) { s.step(dt); ++n; }
+  while (s.time() < t1 + 0.05) {
+    s.step(dt);
+    ++n;
+  }
   // Reaction on the moving edge vs the elastic reaction of a 10 % compression, E t · 0.1 per unit width.
   s.evaluate_forces();
   double fx = 0;
@@ -175,12 +181,20 @@ TEST_CASE("wrinkling: a sheet pushed together stays stable and carries ~no compr
 
 TEST_CASE("sliver triangles are rejected at set-up with their id") {
   st::nodes nd;
-  nd.add({0, 0, 0}); nd.add({1, 0, 0}); nd.add({0, 1, 0}); nd.add({2, 0, 0}); nd.add({3, 1e-5, 0});
+  nd.add({0, 0, 0});
+  nd.add({1, 0, 0});
+  nd.add({0, 1, 0});
+  nd.add({2, 0, 0});
+  nd.add({3, 1e-5, 0});
   st::triangle_mesh m;
   m.triangles = {{0, 1, 2}, {1, 3, 4}};
   st::assembly s{std::move(nd), st::membrane_tri{m, st::material::fabric<>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
   std::string msg;
-  try { s.finalize(); } catch (const parafsi::invalid_input& e) { msg = e.what(); }
+  try {
+    s.finalize();
+  } catch (const parafsi::invalid_input& e) {
+    msg = e.what();
+  }
   INFO(msg);
   CHECK(msg.find("element 1") != std::string::npos);
   CHECK(msg.find("sliver") != std::string::npos);
@@ -189,14 +203,20 @@ TEST_CASE("sliver triangles are rejected at set-up with their id") {
 TEST_CASE("a non-finite reference position or warp direction is refused at set-up, not called a sliver") {
   auto finalize_message = [](Eigen::Vector3d x2, Eigen::Vector3d warp) {
     st::nodes nd;
-    nd.add({0, 0, 0}); nd.add({1, 0, 0}); nd.add({0, 1, 0});
+    nd.add({0, 0, 0});
+    nd.add({1, 0, 0});
+    nd.add({0, 1, 0});
     st::triangle_mesh m;
     m.triangles = {{0, 1, 2}};
     m.reference = {{0, 0, 0}, {1, 0, 0}, x2};  // the stress-free state
     m.warp = warp;
     st::assembly s{std::move(nd), st::membrane_tri{m, st::material::fabric<>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
     std::string msg;
-    try { s.finalize(); } catch (const parafsi::invalid_input& e) { msg = e.what(); }
+    try {
+      s.finalize();
+    } catch (const parafsi::invalid_input& e) {
+      msg = e.what();
+    }
     return msg;
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -238,9 +258,10 @@ TEST_CASE("folded start: reference geometry far from the initial positions runs 
   st::assembly s{std::move(nd), st::membrane_tri{m, fab::isotropic(4e8, 0.2, 0.05, 1e-4), st::membrane_options{0.0}}};
   const auto r = mrig::run_folded(s, 0, [](auto&) {});
   const auto& E = s.energy();
-  std::printf("folded start: apex height %.3f m, max substeps per ms %ld, strain range [%.3e, %.3e], "
-              "K %.3e U %.3e D %.3e W %.3e\n", r.apex, r.max_substeps, r.emin, r.emax, E.kinetic, E.strain, E.damping,
-              E.external);
+  std::printf(
+      "folded start: apex height %.3f m, max substeps per ms %ld, strain range [%.3e, %.3e], "
+      "K %.3e U %.3e D %.3e W %.3e\n",
+      r.apex, r.max_substeps, r.emin, r.emax, E.kinetic, E.strain, E.damping, E.external);
   std::printf("folded start: energy balance error %.3e J of %.3e J input\n", E.balance() - r.U0, r.U0 + E.external);
   mrig::check_folded(r, E);
 }

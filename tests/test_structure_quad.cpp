@@ -25,10 +25,10 @@
 #include "membrane_rig.hpp"
 
 namespace st = parafsi::structure;
-using parafsi::index_t;
 using mrig::rig;
 using mrig::rotation;
 using mrig::square_quads;
+using parafsi::index_t;
 using elastic = st::material::fabric<st::wrinkling::none>;
 
 TEST_CASE("membrane_quad patch test: a uniform strain is reproduced exactly on a distorted mesh") {
@@ -151,10 +151,12 @@ TEST_CASE("membrane_quad hourglass control: a single element loaded in its hourg
   run(0.05, d1, k1);
   run(0.0, d0, k0);
   const double d_exact = F / (4 * k1);
-  std::printf("hourglass load: r_hg = 0.05: delta %.6e m (F/(4k) = %.6e m, k_hg = %.4e N/m); r_hg = 0: delta %.3e m "
-              "after the same time\n", d1, d_exact, k1, d0);
+  std::printf(
+      "hourglass load: r_hg = 0.05: delta %.6e m (F/(4k) = %.6e m, k_hg = %.4e N/m); r_hg = 0: delta %.3e m "
+      "after the same time\n",
+      d1, d_exact, k1, d0);
   CHECK(d1 == doctest::Approx(d_exact).epsilon(0.01));
-  CHECK(std::abs(d1) < 1e-3);             // bounded, far below the element size
+  CHECK(std::abs(d1) < 1e-3);  // bounded, far below the element size
   // Uncontrolled: the mode drifts at the terminal speed F/(m α), δ ≈ 20 F/(4 k_hg) by then
   // and growing linearly in time.
   CHECK(std::abs(d0) > 10 * std::abs(d1));
@@ -168,7 +170,11 @@ TEST_CASE("membrane_quad: degenerate and inverted quads are rejected at set-up w
     m.quads = q;
     st::assembly s{std::move(nd), st::membrane_quad{m, st::material::fabric<>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
     std::string msg;
-    try { s.finalize(); } catch (const parafsi::invalid_input& e) { msg = e.what(); }
+    try {
+      s.finalize();
+    } catch (const parafsi::invalid_input& e) {
+      msg = e.what();
+    }
     return msg;
   };
   const std::vector<Eigen::Vector3d> good{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
@@ -206,7 +212,7 @@ TEST_CASE("membrane_quad: critical step is below 2/omega_max of the element and 
       {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},
       {{0, 0, 0}, {3, 0, 0}, {3, 1, 0}, {0, 1, 0}},
       {{0, 0, 0}, {1.2, 0.1, 0}, {0.9, 0.8, 0}, {-0.2, 1.1, 0}},
-      {{0, 0, 0}, {1, 0, 0}, {1.8, 1, 0}, {0.8, 1, 0}},  // parallelogram, 51° corner
+      {{0, 0, 0}, {1, 0, 0}, {1.8, 1, 0}, {0.8, 1, 0}},      // parallelogram, 51° corner
       {{0, 0, 0}, {1, 0, 0}, {0.7, 0.5, 0}, {0.3, 0.5, 0}},  // trapezoid
   };
   for (double r_hg : {0.05, 0.1})
@@ -224,7 +230,8 @@ TEST_CASE("membrane_quad: critical step is below 2/omega_max of the element and 
         const auto fp = r.forces();
         r.place(xm);
         const auto fm = r.forces();
-        for (int i = 0; i < 12; ++i) K(i, j) = -(fp[std::size_t(i / 3)](i % 3) - fm[std::size_t(i / 3)](i % 3)) / (2 * h);
+        for (int i = 0; i < 12; ++i)
+          K(i, j) = -(fp[std::size_t(i / 3)](i % 3) - fm[std::size_t(i / 3)](i % 3)) / (2 * h);
       }
       r.place(X);
       Eigen::Matrix<double, 12, 12> A = 0.5 * (K + K.transpose());
@@ -280,7 +287,8 @@ TEST_CASE("membrane_quad: SIMD and scalar kernels agree; results do not depend o
   m.quads = d.quads;
   std::mt19937 g(11);
   const auto x = mrig::stretched_noisy(d.positions, g);
-  rig r(d.positions, m, st::material::fabric<>{2e9, 1e9, 0.3, 0.3e9, 0.05, 1e-4}, st::quad_options{0.05, 0.05, 0.1, 0.1});
+  rig r(d.positions, m, st::material::fabric<>{2e9, 1e9, 0.3, 0.3e9, 0.05, 1e-4},
+        st::quad_options{0.05, 0.05, 0.1, 0.1});
   r.mem.set_pressure(100.0);
   r.place(x);
   std::uniform_real_distribution<double> u(-0.01, 0.01);
@@ -297,8 +305,8 @@ TEST_CASE("membrane_quad: energy ledger balances for an undamped pressurised she
   for (int j = 0; j <= 8; ++j)
     for (int i = 0; i <= 8; ++i)
       if (i == 0 || j == 0 || i == 8 || j == 8) nd.pin(index_t(j * 9 + i));
-  st::assembly s{std::move(nd), st::membrane_quad{mesh, st::material::fabric<st::wrinkling::none>::isotropic(
-                                                            1e9, 0.3, 0.05, 1e-4)}};
+  st::assembly s{std::move(nd),
+                 st::membrane_quad{mesh, st::material::fabric<st::wrinkling::none>::isotropic(1e9, 0.3, 0.05, 1e-4)}};
   s.part<0>().set_pressure(50.0);
   s.integrator().gravity.setZero();
   s.track_energy();
@@ -343,16 +351,18 @@ TEST_CASE("clamped circular membrane: quad and triangle agree with each other an
   const double w_quad10 = quad_run(20, 0.10, share10);
   const double w_coarse = quad_run(10, 0.05, share_coarse);
   const double w_ref = hc.w_ref();
-  std::printf("Hencky: w_ref %.8e  tri (N=16) %.8e (%+.3e)  quad (n=20) %.8e (%+.3e), quad vs tri %+.3e; "
-              "r_hg 0.1: %+.3e vs ref; quad n=10: %+.3e vs ref\n", w_ref, w_tri, w_tri / w_ref - 1, w_quad,
-              w_quad / w_ref - 1, w_quad / w_tri - 1, w_quad10 / w_ref - 1, w_coarse / w_ref - 1);
+  std::printf(
+      "Hencky: w_ref %.8e  tri (N=16) %.8e (%+.3e)  quad (n=20) %.8e (%+.3e), quad vs tri %+.3e; "
+      "r_hg 0.1: %+.3e vs ref; quad n=10: %+.3e vs ref\n",
+      w_ref, w_tri, w_tri / w_ref - 1, w_quad, w_quad / w_ref - 1, w_quad / w_tri - 1, w_quad10 / w_ref - 1,
+      w_coarse / w_ref - 1);
   std::printf("Hencky: hourglass share of strain energy %.3e (r_hg 0.05), %.3e (r_hg 0.1), %.3e (n = 10)\n", share05,
               share10, share_coarse);
   CHECK(std::abs(w_quad / w_tri - 1) < 0.02);
   CHECK(std::abs(w_quad / w_ref - 1) < 0.02);
   CHECK(std::abs(w_tri / w_ref - 1) < 0.02);
   CHECK(std::abs(w_quad10 / w_ref - 1) < 0.02);
-  CHECK(std::abs(w_quad / w_ref - 1) < 0.003);  // in fact much closer
+  CHECK(std::abs(w_quad / w_ref - 1) < 0.003);    // in fact much closer
   CHECK(std::abs(w_quad10 / w_quad - 1) < 1e-4);  // insensitive to r_hg
   CHECK(share05 < 1e-3);
   CHECK(share10 < 1e-3);
@@ -372,9 +382,10 @@ TEST_CASE("membrane_quad folded start: reference far from the initial positions 
   double H0 = 0;
   const auto r = mrig::run_folded(s, d.centre, [&](auto& a) { H0 = a.template part<0>().hourglass_energy(); });
   const auto& E = s.energy();
-  std::printf("quad folded start: U0 %.3e J (hourglass %.3e J), apex %.3f m, max substeps/ms %ld, strain [%.3e, %.3e], "
-              "K %.3e U %.3e (hourglass %.3e) D %.3e W %.3e, balance error %.3e of input %.3e\n", r.U0, H0, r.apex,
-              r.max_substeps, r.emin, r.emax, E.kinetic, E.strain, s.part<0>().hourglass_energy(), E.damping,
-              E.external, E.balance() - r.U0, r.U0 + E.external);
+  std::printf(
+      "quad folded start: U0 %.3e J (hourglass %.3e J), apex %.3f m, max substeps/ms %ld, strain [%.3e, %.3e], "
+      "K %.3e U %.3e (hourglass %.3e) D %.3e W %.3e, balance error %.3e of input %.3e\n",
+      r.U0, H0, r.apex, r.max_substeps, r.emin, r.emax, E.kinetic, E.strain, s.part<0>().hourglass_energy(), E.damping,
+      E.external, E.balance() - r.U0, r.U0 + E.external);
   mrig::check_folded(r, E);
 }

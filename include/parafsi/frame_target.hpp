@@ -45,8 +45,9 @@ struct follow_body {
 
   template <class Fluid, class Structure>
   void operator()(Fluid& f, const Structure& s, double dt) const {
-    static_assert(requires(Fluid& fl, const Eigen::Vector3d& x) { fl.frame().track(x, x); },
-                  "follow_body: the fluid's frame must be a tracking frame (frame::follow_payload)");
+    static_assert(
+        requires(Fluid & fl, const Eigen::Vector3d& x) { fl.frame().track(x, x); },
+        "follow_body: the fluid's frame must be a tracking frame (frame::follow_payload)");
     const auto& b = body(s);
     const Eigen::Vector3d xp = b.mass_centre(), vp = b.mass_centre_velocity();
     const Eigen::Vector3d g{0, 0, -gravity};

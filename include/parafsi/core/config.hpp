@@ -15,6 +15,6 @@
 #endif
 
 namespace parafsi {
-using real = double;           ///< floating-point type of every state (SI units)
-using index_t = long;          ///< signed index type for cells, nodes and elements
+using real = double;   ///< floating-point type of every state (SI units)
+using index_t = long;  ///< signed index type for cells, nodes and elements
 }  // namespace parafsi

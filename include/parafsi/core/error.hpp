@@ -24,8 +24,7 @@ struct invalid_input : error {
 
 /// The state became non-finite or violated a physical bound during a run.
 struct numerical_failure : error {
-  numerical_failure(std::string what, long where, double time)
-      : error(std::move(what)), index(where), t(time) {}
+  numerical_failure(std::string what, long where, double time) : error(std::move(what)), index(where), t(time) {}
   long index;  ///< offending cell/element/node index (-1 if not applicable)
   double t;    ///< simulated time of the failure (s)
 };

@@ -25,8 +25,7 @@ struct index_of;
 template <class T, class... Ts>
 struct index_of<T, list<T, Ts...>> : std::integral_constant<std::size_t, 0> {};
 template <class T, class U, class... Ts>
-struct index_of<T, list<U, Ts...>>
-    : std::integral_constant<std::size_t, 1 + index_of<T, list<Ts...>>::value> {};
+struct index_of<T, list<U, Ts...>> : std::integral_constant<std::size_t, 1 + index_of<T, list<Ts...>>::value> {};
 template <class T, class L>
 inline constexpr std::size_t index_of_v = index_of<T, L>::value;
 

@@ -66,7 +66,8 @@ template <class T, class F, class Op>
 inline T reduce(index_t begin, index_t end, T init, F&& f, Op&& op, bool threaded, std::vector<T>& slots) {
   const std::size_t n = static_cast<std::size_t>(end > begin ? end - begin : 0);
   slots.resize(n);
-  for_range(begin, end, [&](index_t i) { slots[static_cast<std::size_t>(i - begin)] = f(i); }, threaded);
+  for_range(
+      begin, end, [&](index_t i) { slots[static_cast<std::size_t>(i - begin)] = f(i); }, threaded);
   T acc = init;
   for (std::size_t i = 0; i < n; ++i) acc = op(acc, slots[i]);
   return acc;

@@ -20,7 +20,9 @@ struct time {};
 }  // namespace kind
 
 template <class T>
-concept policy = requires { typename std::remove_cvref_t<T>::policy_kind; };
+concept policy = requires {
+  typename std::remove_cvref_t<T>::policy_kind;
+};
 
 template <class Kind, class T>
 inline constexpr bool is_kind_v = std::is_same_v<typename std::remove_cvref_t<T>::policy_kind, Kind>;
@@ -34,8 +36,8 @@ struct pick<Kind, Default> {
 };
 template <class Kind, class Default, class P, class... Ps>
 struct pick<Kind, Default, P, Ps...> {
-  using type = std::conditional_t<is_kind_v<Kind, P>, std::remove_cvref_t<P>,
-                                  typename pick<Kind, Default, Ps...>::type>;
+  using type =
+      std::conditional_t<is_kind_v<Kind, P>, std::remove_cvref_t<P>, typename pick<Kind, Default, Ps...>::type>;
 };
 }  // namespace detail
 

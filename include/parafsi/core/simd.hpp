@@ -43,17 +43,13 @@ using mask_t = decltype(std::declval<V>() < std::declval<V>());
 // ---------------------------------------------------------------- load/store
 template <class V>
 PARAFSI_INLINE V load(const double* p) noexcept {
-  if constexpr (is_pack_v<V>)
-    return V::load_unaligned(p);
-  else
-    return *p;
+  if constexpr (is_pack_v<V>) return V::load_unaligned(p);
+  else return *p;
 }
 template <class V>
 PARAFSI_INLINE V load_aligned(const double* p) noexcept {
-  if constexpr (is_pack_v<V>)
-    return V::load_aligned(p);
-  else
-    return *p;
+  if constexpr (is_pack_v<V>) return V::load_aligned(p);
+  else return *p;
 }
 PARAFSI_INLINE void store(double* p, double v) noexcept { *p = v; }
 template <class A>
@@ -80,8 +76,7 @@ PARAFSI_INLINE V iota() noexcept {
 // ---------------------------------------------------------------- math on V
 PARAFSI_INLINE double select(bool c, double a, double b) noexcept { return c ? a : b; }
 template <class A>
-PARAFSI_INLINE xsimd::batch<double, A> select(const xsimd::batch_bool<double, A>& c,
-                                              const xsimd::batch<double, A>& a,
+PARAFSI_INLINE xsimd::batch<double, A> select(const xsimd::batch_bool<double, A>& c, const xsimd::batch<double, A>& a,
                                               const xsimd::batch<double, A>& b) noexcept {
   return xsimd::select(c, a, b);
 }
@@ -101,11 +96,17 @@ PARAFSI_INLINE auto max(const xsimd::batch<double, A>& a, const xsimd::batch<dou
   return xsimd::max(a, b);
 }
 template <class A>
-PARAFSI_INLINE auto abs(const xsimd::batch<double, A>& a) noexcept { return xsimd::abs(a); }
+PARAFSI_INLINE auto abs(const xsimd::batch<double, A>& a) noexcept {
+  return xsimd::abs(a);
+}
 template <class A>
-PARAFSI_INLINE auto sqrt(const xsimd::batch<double, A>& a) noexcept { return xsimd::sqrt(a); }
+PARAFSI_INLINE auto sqrt(const xsimd::batch<double, A>& a) noexcept {
+  return xsimd::sqrt(a);
+}
 template <class A>
-PARAFSI_INLINE auto sin(const xsimd::batch<double, A>& a) noexcept { return xsimd::sin(a); }
+PARAFSI_INLINE auto sin(const xsimd::batch<double, A>& a) noexcept {
+  return xsimd::sin(a);
+}
 template <class A>
 PARAFSI_INLINE auto pow(const xsimd::batch<double, A>& a, const xsimd::batch<double, A>& b) noexcept {
   return xsimd::pow(a, b);
@@ -119,14 +120,20 @@ PARAFSI_INLINE auto copysign(const xsimd::batch<double, A>& a, const xsimd::batc
 PARAFSI_INLINE bool any(bool m) noexcept { return m; }
 PARAFSI_INLINE bool all(bool m) noexcept { return m; }
 template <class A>
-PARAFSI_INLINE bool any(const xsimd::batch_bool<double, A>& m) noexcept { return xsimd::any(m); }
+PARAFSI_INLINE bool any(const xsimd::batch_bool<double, A>& m) noexcept {
+  return xsimd::any(m);
+}
 template <class A>
-PARAFSI_INLINE bool all(const xsimd::batch_bool<double, A>& m) noexcept { return xsimd::all(m); }
+PARAFSI_INLINE bool all(const xsimd::batch_bool<double, A>& m) noexcept {
+  return xsimd::all(m);
+}
 
 /// Horizontal sum (xsimd 8.1 names it `hadd`).
 PARAFSI_INLINE double hsum(double a) noexcept { return a; }
 template <class A>
-PARAFSI_INLINE double hsum(const xsimd::batch<double, A>& a) noexcept { return xsimd::hadd(a); }
+PARAFSI_INLINE double hsum(const xsimd::batch<double, A>& a) noexcept {
+  return xsimd::hadd(a);
+}
 /// Horizontal max.
 PARAFSI_INLINE double hmax(double a) noexcept { return a; }
 template <class A>
@@ -164,7 +171,9 @@ struct aligned_allocator {
   }
   void deallocate(T* p, std::size_t) noexcept { std::free(p); }
   template <class U>
-  bool operator==(const aligned_allocator<U, Align>&) const noexcept { return true; }
+  bool operator==(const aligned_allocator<U, Align>&) const noexcept {
+    return true;
+  }
 };
 template <class T>
 using aligned_vector = std::vector<T, aligned_allocator<T>>;

@@ -40,14 +40,16 @@ class soa {
 
   template <class Tag>
   double* get() noexcept {
-    static_assert(has<Tag>(), "this SoA container does not hold the requested field: "
-                              "add its tag to the policy's `fields` list");
+    static_assert(has<Tag>(),
+                  "this SoA container does not hold the requested field: "
+                  "add its tag to the policy's `fields` list");
     return data_[meta::index_of_v<Tag, fields>].data();
   }
   template <class Tag>
   const double* get() const noexcept {
-    static_assert(has<Tag>(), "this SoA container does not hold the requested field: "
-                              "add its tag to the policy's `fields` list");
+    static_assert(has<Tag>(),
+                  "this SoA container does not hold the requested field: "
+                  "add its tag to the policy's `fields` list");
     return data_[meta::index_of_v<Tag, fields>].data();
   }
   template <class Tag>

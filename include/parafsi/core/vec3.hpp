@@ -14,7 +14,9 @@ struct vec3 {
   PARAFSI_INLINE vec3 operator-(const vec3& o) const noexcept { return {x - o.x, y - o.y, z - o.z}; }
   PARAFSI_INLINE vec3 operator*(const V& s) const noexcept { return {x * s, y * s, z * s}; }
   PARAFSI_INLINE vec3& operator+=(const vec3& o) noexcept {
-    x += o.x; y += o.y; z += o.z;
+    x += o.x;
+    y += o.y;
+    z += o.z;
     return *this;
   }
 };

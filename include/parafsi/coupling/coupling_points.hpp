@@ -40,11 +40,11 @@ namespace parafsi::coupling {
 
 /// Eight-cell trilinear stencil of one point.
 struct stencil {
-  index_t base = 0;            ///< linear index of the (i0, j0, k0) corner cell
+  index_t base = 0;              ///< linear index of the (i0, j0, k0) corner cell
   std::array<index_t, 3> ijk{};  ///< i0, j0, k0
-  std::array<double, 3> t{};   ///< fractions along each axis
-  double h = 0;                ///< local cell size (cube root of the containing cell's volume)
-  bool inside = false;         ///< the point lies inside the box
+  std::array<double, 3> t{};     ///< fractions along each axis
+  double h = 0;                  ///< local cell size (cube root of the containing cell's volume)
+  bool inside = false;           ///< the point lies inside the box
   /// Weight of corner a (bit 0: +x, bit 1: +y, bit 2: +z).
   double weight(int a) const noexcept {
     return (a & 1 ? t[0] : 1.0 - t[0]) * (a & 2 ? t[1] : 1.0 - t[1]) * (a & 4 ? t[2] : 1.0 - t[2]);
@@ -147,7 +147,9 @@ class coupling_points {
     opt.validate();
     tris_ = tris;
     elem_.clear();
-    w_[0].clear(); w_[1].clear(); w_[2].clear();
+    w_[0].clear();
+    w_[1].clear();
+    w_[2].clear();
     first_.assign(1, 0);
     nquad_.clear();
     const double hmin = loc.grid().min_width();

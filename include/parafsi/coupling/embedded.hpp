@@ -90,26 +90,26 @@ struct embedded_options {
             impedance);
     require(max_cells_per_step > 0 && std::isfinite(max_cells_per_step),
             "coupling::embedded: max_cells_per_step must be > 0, got ", max_cells_per_step);
-    require(root_tolerance > 0 && root_tolerance < 1e-3, "coupling::embedded: root_tolerance must be in (0, 1e-3), got ",
-            root_tolerance);
+    require(root_tolerance > 0 && root_tolerance < 1e-3,
+            "coupling::embedded: root_tolerance must be in (0, 1e-3), got ", root_tolerance);
   }
 };
 
 /// Per-step diagnostics.
 struct embedded_diagnostics {
-  double max_penetration_over_h = 0;  ///< always 0: the membrane is a wall in the scheme
-  index_t faces = 0;                  ///< patched faces this step
-  index_t crossings = 0;              ///< face–element crossings (after merging)
-  index_t multi_layer_faces = 0;      ///< faces crossed by more than one layer
+  double max_penetration_over_h = 0;                            ///< always 0: the membrane is a wall in the scheme
+  index_t faces = 0;                                            ///< patched faces this step
+  index_t crossings = 0;                                        ///< face–element crossings (after merging)
+  index_t multi_layer_faces = 0;                                ///< faces crossed by more than one layer
   Eigen::Vector3d impulse_structure = Eigen::Vector3d::Zero();  ///< Σ J of the step (N s)
   /// Impulse of the impedance term this step (N s; included in impulse_structure, zero
   /// when impedance = 0): the momentum in flight between the air and the structure.
   Eigen::Vector3d impulse_impedance = Eigen::Vector3d::Zero();
   double impedance_substep = std::numeric_limits<double>::infinity();  ///< its substep limit (s)
-  double work_fluid = 0;       ///< energy the air gave through the patched faces this step (J)
-  double work_structure = 0;   ///< Σ F·v_s kick over the substeps (J)
-  double mass_defect = 0;      ///< Σ β Δt A (F_L − F_R).ρ: mass not conserved by the swept terms (kg)
-  double max_through_velocity = 0;  ///< max |u_p| of the step (m/s)
+  double work_fluid = 0;             ///< energy the air gave through the patched faces this step (J)
+  double work_structure = 0;         ///< Σ F·v_s kick over the substeps (J)
+  double mass_defect = 0;            ///< Σ β Δt A (F_L − F_R).ρ: mass not conserved by the swept terms (kg)
+  double max_through_velocity = 0;   ///< max |u_p| of the step (m/s)
   std::vector<double> through_flow;  ///< per element: Σ u_p A_face/k along +n_e (m³/s), last stage
 };
 
@@ -202,11 +202,12 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
         const double travel = vr.norm() * dt_f / h;
         if (travel > opt_.max_cells_per_step)
           throw numerical_failure(
-              parafsi::detail::concat("coupling::embedded: membrane element ", e, " (node ", t[std::size_t(a)], ") moves ",
-                             vr.norm(), " m/s relative to the fluid grid, ", travel, " cells of size ", h,
-                             " m in one fluid step of ", dt_f, " s (limit ", opt_.max_cells_per_step,
-                             " cell per step); the membrane would jump over cell centres: reduce the time step "
-                             "(explicit_stepper::stable_dt() includes this limit)"),
+              parafsi::detail::concat(
+                  "coupling::embedded: membrane element ", e, " (node ", t[std::size_t(a)], ") moves ", vr.norm(),
+                  " m/s relative to the fluid grid, ", travel, " cells of size ", h, " m in one fluid step of ", dt_f,
+                  " s (limit ", opt_.max_cells_per_step,
+                  " cell per step); the membrane would jump over cell centres: reduce the time step "
+                  "(explicit_stepper::stable_dt() includes this limit)"),
               e, f.time());
       }
     }
@@ -306,7 +307,6 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
   }
 
  public:
-
   // ------------------------------------------------------------- face physics
   /// Pressure and density behind the wave a piston makes in the state (ρ, p, c) when it
   /// approaches the gas at du (du > 0: compression/shock, du < 0: rarefaction).
@@ -564,8 +564,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
                  fluid::cons<double>& hi) {
     const std::size_t fi = fc.patch;
     const int stage = fc.stage;
-    require(fi < faces_.size() && stage >= 0 && stage < int(beta_.size()),
-            "coupling::embedded: face ", fi, " at stage ", stage, " is not one of this step's patches");
+    require(fi < faces_.size() && stage >= 0 && stage < int(beta_.size()), "coupling::embedded: face ", fi,
+            " at stage ", stage, " is not one of this step's patches");
     const face_rec& fr = faces_[fi];
     require(fc.high == fr.high && fc.axis == fr.axis, "coupling::embedded: patched face ", fi,
             " does not match the face list of the last exchange");
@@ -632,7 +632,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
   std::vector<Eigen::Matrix3d> node_C_;
   std::vector<index_t> touched_;
   std::vector<double> beta_;
-  std::vector<raw_crossing> found_;           ///< find_faces scratch
+  std::vector<raw_crossing> found_;            ///< find_faces scratch
   std::vector<fluid::patch_face> patch_list_;  ///< the faces patched in the coming fluid step
   bool spread_ready_ = false;
   embedded_diagnostics diag_{};

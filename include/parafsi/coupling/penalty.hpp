@@ -57,9 +57,9 @@
 
 #include "../core/error.hpp"
 #include "../fluid/solver.hpp"
+#include "../fluid/view.hpp"
 #include "../structure/assembly.hpp"
 #include "../structure/nodes.hpp"
-#include "../fluid/view.hpp"
 #include "coupling_points.hpp"
 #include "detail/membrane_coupling.hpp"
 #include "kinds.hpp"
@@ -68,10 +68,10 @@
 namespace parafsi::coupling {
 
 struct penalty_options {
-  double pfac = 0.1;              ///< PFAC in k_c = PFAC K A_c / h
-  double damping_ratio = 0.0;     ///< ζ of the coupling damper (0 = LS-DYNA default)
-  double stiffening = 0.0;        ///< λ: k ← k(1 + (|d|/(λh))²); 0 = off (0.25 recommended)
-  double fluid_cap = 1.0;         ///< per-cell Σ w k Δt_f²/(ρV) cap; 0 = no capping
+  double pfac = 0.1;                ///< PFAC in k_c = PFAC K A_c / h
+  double damping_ratio = 0.0;       ///< ζ of the coupling damper (0 = LS-DYNA default)
+  double stiffening = 0.0;          ///< λ: k ← k(1 + (|d|/(λh))²); 0 = off (0.25 recommended)
+  double fluid_cap = 1.0;           ///< per-cell Σ w k Δt_f²/(ρV) cap; 0 = no capping
   double max_cells_per_step = 1.0;  ///< reject steps where a point moves farther (cells)
   point_options points{};
 
@@ -89,12 +89,12 @@ struct penalty_options {
 
 /// Per-step diagnostics (methods §8.3 step 6).
 struct penalty_diagnostics {
-  double max_penetration_over_h = 0;  ///< max |d|/h over points and substeps of the step
-  double min_stiffness_scale = 1;     ///< smallest cap scaling s_c of the step
+  double max_penetration_over_h = 0;                            ///< max |d|/h over points and substeps of the step
+  double min_stiffness_scale = 1;                               ///< smallest cap scaling s_c of the step
   Eigen::Vector3d impulse_structure = Eigen::Vector3d::Zero();  ///< Σ F_s Δt̄ of the step (N s)
-  double work_fluid = 0;              ///< Σ W of the step: energy given to the air (J)
-  double work_structure = 0;          ///< Σ F_s·v_s Δt̄ of the step (J)
-  double coupling_energy = 0;         ///< cumulative Σ F_s·(v_f − v_s) Δt̄ (J): spring + porous loss
+  double work_fluid = 0;                                        ///< Σ W of the step: energy given to the air (J)
+  double work_structure = 0;                                    ///< Σ F_s·v_s Δt̄ of the step (J)
+  double coupling_energy = 0;  ///< cumulative Σ F_s·(v_f − v_s) Δt̄ (J): spring + porous loss
   index_t active_points = 0, inactive_points = 0;
   std::vector<double> through_flow;   ///< per element: Σ u_p A_c (m³/s, along +n), last substep
   std::vector<double> relative_flow;  ///< per element: Σ v_rn A_c (m³/s), last substep
@@ -150,14 +150,16 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
     loc_ = grid_locator(f.grid());
     const std::vector<detail::triangle> tris = this->attach_triangles(s);
     const auto& nd = s.node_set();
-    pts_.build(tris, [&](index_t i) { return nd.position(i); }, loc_, f.pose(), opt_.points);
+    pts_.build(
+        tris, [&](index_t i) { return nd.position(i); }, loc_, f.pose(), opt_.points);
     const index_t n = pts_.size();
     d_.assign(std::size_t(n), 0.0);
     scale_.assign(std::size_t(n), 1.0);
     // Share of every node's weight (for the point mass share m_s).
     node_wsum_.assign(std::size_t(nd.size()), 0.0);
     for (index_t c = 0; c < n; ++c)
-      for (int a = 0; a < 3; ++a) node_wsum_[std::size_t(pts_.nodes_of(pts_.element(c))[std::size_t(a)])] += pts_.weight(c, a);
+      for (int a = 0; a < 3; ++a)
+        node_wsum_[std::size_t(pts_.nodes_of(pts_.element(c))[std::size_t(a)])] += pts_.weight(c, a);
     node_k_.assign(std::size_t(nd.size()), 0.0);
     diag_.through_flow.assign(std::size_t(pts_.elements()), 0.0);
     diag_.relative_flow.assign(std::size_t(pts_.elements()), 0.0);
@@ -236,11 +238,12 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
         const double travel = (vs - wg).norm() * dt_f / sc.h;
         if (travel > opt_.max_cells_per_step)
           throw numerical_failure(
-              parafsi::detail::concat("coupling::penalty: membrane element ", e, " moves ", (vs - wg).norm(),
-                             " m/s relative to the fluid grid, ", travel, " cells of size ", sc.h, " m in one fluid step of ",
-                             dt_f, " s (limit ", opt_.max_cells_per_step,
-                             " cell per step); the coupling would skip cells: reduce the time step (explicit_stepper::"
-                             "stable_dt() includes this limit)"),
+              parafsi::detail::concat(
+                  "coupling::penalty: membrane element ", e, " moves ", (vs - wg).norm(),
+                  " m/s relative to the fluid grid, ", travel, " cells of size ", sc.h, " m in one fluid step of ",
+                  dt_f, " s (limit ", opt_.max_cells_per_step,
+                  " cell per step); the coupling would skip cells: reduce the time step (explicit_stepper::"
+                  "stable_dt() includes this limit)"),
               e, f.time());
       }
     }
@@ -259,7 +262,8 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
       scale_[std::size_t(c)] = sfac;
       diag_.min_stiffness_scale = std::min(diag_.min_stiffness_scale, sfac);
       const auto& tri = pts_.nodes_of(pts_.element(c));
-      for (int a = 0; a < 3; ++a) node_k_[std::size_t(tri[std::size_t(a)])] += pts_.weight(c, a) * kraw[std::size_t(c)] * sfac;
+      for (int a = 0; a < 3; ++a)
+        node_k_[std::size_t(tri[std::size_t(a)])] += pts_.weight(c, a) * kraw[std::size_t(c)] * sfac;
     }
     if (opt_.fluid_cap > 0)
       for (index_t c = 0; c < n; ++c)

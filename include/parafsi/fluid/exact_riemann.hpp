@@ -33,7 +33,7 @@ class exact_riemann {
   /// Solution at similarity coordinate s = (x − x0)/t.
   riemann_state sample(double s) const noexcept {
     const double g = g_;
-    if (s <= us_) {  // left of the contact
+    if (s <= us_) {      // left of the contact
       if (ps_ > L_.p) {  // left shock
         const double SL = L_.u - cL_ * std::sqrt((g + 1) / (2 * g) * ps_ / L_.p + (g - 1) / (2 * g));
         if (s <= SL) return L_;

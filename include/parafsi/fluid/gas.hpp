@@ -2,15 +2,15 @@
 /// Ideal (calorically perfect) gas:  p = (γ − 1) ρ e,  c² = γ p / ρ,  T = p / (ρ R).
 /// Defaults are dry air: γ = 1.4, R = 287.05 J/(kg K).
 #pragma once
-#include "../core/policy.hpp"
 #include "../core/error.hpp"
+#include "../core/policy.hpp"
 #include "../core/simd.hpp"
 
 namespace parafsi::gas {
 
 struct ideal {
-  double gamma = 1.4;   ///< ratio of specific heats (-)
-  double R = 287.05;    ///< specific gas constant (J/(kg K))
+  double gamma = 1.4;  ///< ratio of specific heats (-)
+  double R = 287.05;   ///< specific gas constant (J/(kg K))
 
   using policy_kind = kind::gas;
   static constexpr const char* name() noexcept { return "ideal_gas"; }
@@ -31,14 +31,12 @@ struct ideal {
   }
   /// Pressure from density, momentum and total energy per volume.
   template <class V>
-  PARAFSI_INLINE V pressure(const V& rho, const V& mx, const V& my, const V& mz,
-                            const V& E) const noexcept {
+  PARAFSI_INLINE V pressure(const V& rho, const V& mx, const V& my, const V& mz, const V& E) const noexcept {
     return V(gamma - 1.0) * (E - V(0.5) * (mx * mx + my * my + mz * mz) / rho);
   }
   /// Total energy per volume from primitives.
   template <class V>
-  PARAFSI_INLINE V total_energy(const V& rho, const V& u, const V& v, const V& w,
-                                const V& p) const noexcept {
+  PARAFSI_INLINE V total_energy(const V& rho, const V& u, const V& v, const V& w, const V& p) const noexcept {
     return p / V(gamma - 1.0) + V(0.5) * rho * (u * u + v * v + w * w);
   }
 };

@@ -75,8 +75,8 @@ class rectilinear_grid {
       const auto& f = axes_[d].faces;
       require(f.size() >= 2, "rectilinear_grid: axis ", d, " needs at least one cell");
       for (std::size_t i = 1; i < f.size(); ++i)
-        require(f[i] > f[i - 1], "rectilinear_grid: axis ", d, " faces not increasing at face ", i,
-                " (", f[i - 1], " >= ", f[i], ")");
+        require(f[i] > f[i - 1], "rectilinear_grid: axis ", d, " faces not increasing at face ", i, " (", f[i - 1],
+                " >= ", f[i], ")");
       n_[d] = axes_[d].cells();
       build_axis(d);
     }
@@ -86,10 +86,8 @@ class rectilinear_grid {
   }
 
   /// Uniform box [lo, hi] with n cells per axis.
-  static rectilinear_grid uniform(std::array<index_t, 3> n, std::array<double, 3> lo,
-                                  std::array<double, 3> hi) {
-    return {axis::uniform(n[0], lo[0], hi[0]), axis::uniform(n[1], lo[1], hi[1]),
-            axis::uniform(n[2], lo[2], hi[2])};
+  static rectilinear_grid uniform(std::array<index_t, 3> n, std::array<double, 3> lo, std::array<double, 3> hi) {
+    return {axis::uniform(n[0], lo[0], hi[0]), axis::uniform(n[1], lo[1], hi[1]), axis::uniform(n[2], lo[2], hi[2])};
   }
 
   index_t n(int d) const noexcept { return n_[d]; }
@@ -116,9 +114,7 @@ class rectilinear_grid {
   const double* half_widths(int d) const noexcept { return hdx_[d].data() + ghosts; }
   /// 1 / (x_c[i] − x_c[i−1]) (distance between the centres left of and at cell i).
   const double* inv_centre_gaps(int d) const noexcept { return idc_[d].data() + ghosts; }
-  double cell_volume(index_t i, index_t j, index_t k) const noexcept {
-    return width(0, i) * width(1, j) * width(2, k);
-  }
+  double cell_volume(index_t i, index_t j, index_t k) const noexcept { return width(0, i) * width(1, j) * width(2, k); }
   /// Volume of the cell at flat index c.
   double cell_volume(index_t c) const noexcept {
     const auto q = ijk(c);

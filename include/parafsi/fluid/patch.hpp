@@ -35,13 +35,13 @@ struct patch_face {
 struct face_context {
   index_t low = 0, high = 0;  ///< flat indices, high = low + stride(axis)
   int axis = 0;
-  int stage = 0;              ///< RK stage (0 … Time::stages − 1)
-  std::size_t patch = 0;      ///< position of the face in the patcher's list
-  prim<double> L{}, R{};      ///< reconstructed states on the low and high side
-  vec3<double> n{};           ///< unit normal (inertial), from low to high
-  double wn = 0;              ///< grid normal speed of the face
-  double area = 0;            ///< face area (m²)
-  Eigen::Vector3d centre{};   ///< face centre in box coordinates ξ
+  int stage = 0;             ///< RK stage (0 … Time::stages − 1)
+  std::size_t patch = 0;     ///< position of the face in the patcher's list
+  prim<double> L{}, R{};     ///< reconstructed states on the low and high side
+  vec3<double> n{};          ///< unit normal (inertial), from low to high
+  double wn = 0;             ///< grid normal speed of the face
+  double area = 0;           ///< face area (m²)
+  Eigen::Vector3d centre{};  ///< face centre in box coordinates ξ
 };
 
 template <class P>
@@ -66,8 +66,7 @@ struct face_patches {
   void patch(const face_context& fc, const view& v, cons<double>& lo, cons<double>& hi) {
     if constexpr (std::invocable<Handler&, const face_context&, const view&, cons<double>&, cons<double>&>)
       handler(fc, v, lo, hi);
-    else
-      handler(fc, lo, hi);
+    else handler(fc, lo, hi);
   }
 };
 template <class Handler>

@@ -86,8 +86,8 @@ struct totals {
 };
 
 template <class Flux = flux::hllc_lm, class Recon = recon::muscl<limiter::van_leer>,
-          class Turbulence = turbulence::none, class Viscosity = viscosity::inviscid,
-          class Frame = frame::fixed, class Time = time::ssp_rk2>
+          class Turbulence = turbulence::none, class Viscosity = viscosity::inviscid, class Frame = frame::fixed,
+          class Time = time::ssp_rk2>
 class solver {
  public:
   using flux_type = Flux;
@@ -108,11 +108,9 @@ class solver {
   using cons_storage = soa_of_t<conserved_fields>;
   using prim_storage = soa_of_t<primitive_fields>;
   using viscous_storage = std::conditional_t<is_viscous, soa_of_t<viscous_fields>, empty_storage>;
-  using turbulence_storage =
-      std::conditional_t<has_eddy_viscosity,
-                         std::conditional_t<needs_wall_distance, soa<field::mu_t, field::wall_distance>,
-                                            soa<field::mu_t>>,
-                         empty_storage>;
+  using turbulence_storage = std::conditional_t<
+      has_eddy_viscosity,
+      std::conditional_t<needs_wall_distance, soa<field::mu_t, field::wall_distance>, soa<field::mu_t>>, empty_storage>;
 
   /// Compose from a grid, boundary set and any policy values (order free).
   template <policy... Ps>
@@ -126,8 +124,7 @@ class solver {
         visc_(pick_value<kind::viscosity, Viscosity>(policies...)),
         frame_(pick_value<kind::frame, Frame>(policies...)) {
     static_assert(((count_kind_v<kind::gas, Ps...> <= 1) && (count_kind_v<kind::flux, Ps...> <= 1) &&
-                   (count_kind_v<kind::reconstruction, Ps...> <= 1) &&
-                   (count_kind_v<kind::turbulence, Ps...> <= 1) &&
+                   (count_kind_v<kind::reconstruction, Ps...> <= 1) && (count_kind_v<kind::turbulence, Ps...> <= 1) &&
                    (count_kind_v<kind::viscosity, Ps...> <= 1) && (count_kind_v<kind::frame, Ps...> <= 1) &&
                    (count_kind_v<kind::time, Ps...> <= 1)),
                   "fluid::solver: at most one policy of each kind (gas, flux, reconstruction, "
@@ -157,8 +154,8 @@ class solver {
     }
     if (bc_.layer.cells > 0) {
       sponge_.emplace(N, 0.0);
-      sponge_target_ =
-          detail::setup_sponge(grid_, bc_, gas_, sponge_->template get<field::sponge_sigma>(), sponge_target_);
+      sponge_target_ = detail::setup_sponge(grid_, bc_, gas_, sponge_->template get<field::sponge_sigma>(),
+                                            sponge_target_);
     }
     bad_rows_.assign(std::size_t(grid_.n(1) * grid_.n(2)), 0);
     threaded_ = grid_.interior_cells() >= 32768;
@@ -229,8 +226,8 @@ class solver {
 
   /// Composed policy names, for logs.
   std::string name() const {
-    return std::string("fluid::solver<") + Flux::name() + ", recon:" + Recon::name() + ", " +
-           Turbulence::name() + ", " + Viscosity::name() + ", " + Frame::name() + ", " + Time::name() + ">";
+    return std::string("fluid::solver<") + Flux::name() + ", recon:" + Recon::name() + ", " + Turbulence::name() +
+           ", " + Viscosity::name() + ", " + Frame::name() + ", " + Time::name() + ">";
   }
 
   /// Enable the per-cell source hook (momentum N/m³ and energy W/m³, inertial),
@@ -254,18 +251,14 @@ class solver {
     }
   }
   /// Distance to the nearest body per cell (mixing-length closure); +∞ by default.
-  double* wall_distance() requires needs_wall_distance {
-    return turb_store_.template get<field::wall_distance>();
-  }
+  double* wall_distance() requires needs_wall_distance { return turb_store_.template get<field::wall_distance>(); }
 
   // ------------------------------------------------------------------ access
   index_t index(index_t i, index_t j, index_t k) const noexcept { return grid_.index(i, j, k); }
   cons<double> conserved(index_t i, index_t j, index_t k) const noexcept {
     return detail::load_cons(detail::conserved_ptrs(U_), grid_.index(i, j, k));
   }
-  prim<double> primitive(index_t i, index_t j, index_t k) const noexcept {
-    return to_prim(conserved(i, j, k), gas_);
-  }
+  prim<double> primitive(index_t i, index_t j, index_t k) const noexcept { return to_prim(conserved(i, j, k), gas_); }
   void set_primitive(index_t i, index_t j, index_t k, const prim<double>& w) {
     validate_state(w, "set_primitive");
     detail::store_cons(detail::conserved_ptrs(U_), grid_.index(i, j, k), to_cons(w, gas_));
@@ -275,9 +268,7 @@ class solver {
   const cons_storage& conserved_storage() const noexcept { return U_; }
   cons_storage& conserved_storage() noexcept { return U_; }
   /// Eddy viscosity field (after the last stage).
-  const double* eddy_viscosity() const requires has_eddy_viscosity {
-    return turb_store_.template get<field::mu_t>();
-  }
+  const double* eddy_viscosity() const requires has_eddy_viscosity { return turb_store_.template get<field::mu_t>(); }
   /// Sums over interior cells, in a fixed order (bit-reproducible).
   fluid::totals totals() const {
     fluid::totals t;
@@ -373,11 +364,12 @@ class solver {
                [d](const std::vector<double>& file, const std::vector<double>& mine) -> std::string {
                  if (file.size() != mine.size())
                    return parafsi::detail::concat("grid axis ", d, " has ", index_t(file.size()) - 1,
-                                         " cells in the file but ", index_t(mine.size()) - 1, " in this solver");
+                                                  " cells in the file but ", index_t(mine.size()) - 1,
+                                                  " in this solver");
                  for (std::size_t i = 0; i < file.size(); ++i)
                    if (file[i] != mine[i])
-                     return parafsi::detail::concat("grid axis ", d, " face ", i, " is at ", file[i], " in the file but ",
-                                           mine[i], " in this solver");
+                     return parafsi::detail::concat("grid axis ", d, " face ", i, " is at ", file[i],
+                                                    " in the file but ", mine[i], " in this solver");
                  return {};
                });
     ar.check("total_cells", self.grid_.total_cells(), "the cell count incl. ghosts");
@@ -414,8 +406,8 @@ class solver {
   void validate_state(const prim<double>& w, const char* where) const {
     require(std::isfinite(w.rho) && w.rho > 0.0, "fluid::solver::", where, ": density must be > 0, got ", w.rho);
     require(std::isfinite(w.p) && w.p > 0.0, "fluid::solver::", where, ": pressure must be > 0, got ", w.p);
-    require(std::isfinite(w.u.x) && std::isfinite(w.u.y) && std::isfinite(w.u.z),
-            "fluid::solver::", where, ": velocity must be finite");
+    require(std::isfinite(w.u.x) && std::isfinite(w.u.y) && std::isfinite(w.u.z), "fluid::solver::", where,
+            ": velocity must be finite");
   }
 
   // ------------------------------------------------------------------ phases
@@ -444,8 +436,10 @@ class solver {
       timed(times_.fluxes, [&] { detail::patch_faces(fk, geo, view(), stage, dU, patcher); });
     if constexpr (is_viscous)
       timed(times_.viscous, [&] {
-        detail::viscous_pass<Viscosity, Turbulence, viscous_storage, turbulence_storage>{
-            visc_, turb_, gas_, grid_, visc_store_, turb_store_, threaded_}(geo, W, dU);
+        detail::viscous_pass<Viscosity, Turbulence, viscous_storage, turbulence_storage>{visc_,       turb_,
+                                                                                         gas_,        grid_,
+                                                                                         visc_store_, turb_store_,
+                                                                                         threaded_}(geo, W, dU);
       });
     if (sources_ || sponge_) timed(times_.sources, [&] { add_sources(); });
   }
@@ -498,7 +492,7 @@ class solver {
   std::optional<soa<field::sponge_sigma>> sponge_;
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   std::vector<detail::row_buffers> bufs_;
-  std::vector<char> bad_rows_;            ///< per interior row: non-physical state found
+  std::vector<char> bad_rows_;              ///< per interior row: non-physical state found
   mutable std::vector<double> rate_slots_;  ///< per-row maxima of stable_dt
   phase_times times_{};
   bool threaded_ = true;

@@ -20,12 +20,8 @@ struct cons {
   V rho;
   vec3<V> m;
   V E;
-  PARAFSI_INLINE cons operator+(const cons& o) const noexcept {
-    return {rho + o.rho, m + o.m, E + o.E};
-  }
-  PARAFSI_INLINE cons operator-(const cons& o) const noexcept {
-    return {rho - o.rho, m - o.m, E - o.E};
-  }
+  PARAFSI_INLINE cons operator+(const cons& o) const noexcept { return {rho + o.rho, m + o.m, E + o.E}; }
+  PARAFSI_INLINE cons operator-(const cons& o) const noexcept { return {rho - o.rho, m - o.m, E - o.E}; }
   PARAFSI_INLINE cons operator*(const V& s) const noexcept { return {rho * s, m * s, E * s}; }
 };
 
@@ -50,8 +46,7 @@ PARAFSI_INLINE prim<V> to_prim(const cons<V>& q, const gas::ideal& g) noexcept {
 
 /// Inviscid flux through a unit normal n of a fixed face, given u_n = u·n.
 template <class V>
-PARAFSI_INLINE cons<V> physical_flux(const prim<V>& w, const V& E, const V& un,
-                                     const vec3<double>& n) noexcept {
+PARAFSI_INLINE cons<V> physical_flux(const prim<V>& w, const V& E, const V& un, const vec3<double>& n) noexcept {
   const V mflux = w.rho * un;
   return {mflux,
           {mflux * w.u.x + w.p * V(n.x), mflux * w.u.y + w.p * V(n.y), mflux * w.u.z + w.p * V(n.z)},

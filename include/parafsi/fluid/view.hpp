@@ -27,13 +27,19 @@ struct view {
   const double* mx = nullptr;   ///< momentum per volume, inertial components (kg/(m² s))
   const double* my = nullptr;
   const double* mz = nullptr;
-  const double* E = nullptr;    ///< total energy per volume (J/m³)
+  const double* E = nullptr;  ///< total energy per volume (J/m³)
 
   /// View of a conserved storage (soa over conserved_fields).
   template <class Storage>
   static view of(const rectilinear_grid& g, const frame::pose& p, const gas::ideal& gas, const Storage& U) noexcept {
-    return {&g, &p, gas, U.template get<field::rho>(), U.template get<field::mx>(), U.template get<field::my>(),
-            U.template get<field::mz>(), U.template get<field::E>()};
+    return {&g,
+            &p,
+            gas,
+            U.template get<field::rho>(),
+            U.template get<field::mx>(),
+            U.template get<field::my>(),
+            U.template get<field::mz>(),
+            U.template get<field::E>()};
   }
 
   index_t index(index_t i, index_t j, index_t k) const noexcept { return grid->index(i, j, k); }
@@ -41,9 +47,7 @@ struct view {
 
   double density(index_t c) const noexcept { return rho[c]; }
   /// Inertial velocity m/ρ of cell c (m/s).
-  Eigen::Vector3d velocity(index_t c) const noexcept {
-    return Eigen::Vector3d(mx[c], my[c], mz[c]) / rho[c];
-  }
+  Eigen::Vector3d velocity(index_t c) const noexcept { return Eigen::Vector3d(mx[c], my[c], mz[c]) / rho[c]; }
   double pressure(index_t c) const noexcept { return gas.pressure(rho[c], mx[c], my[c], mz[c], E[c]); }
   /// Bulk modulus γ p of cell c (Pa).
   double bulk_modulus(index_t c) const noexcept { return gas.gamma * pressure(c); }

@@ -112,7 +112,7 @@ struct digest_feed {
   fnv1a_hash& hash;
   void operator()(double v) const { hash.add(&v, sizeof v); }
   template <class I>
-    requires std::is_integral_v<I>
+  requires std::is_integral_v<I>
   void operator()(I v) const {
     const auto w = static_cast<std::int64_t>(v);
     hash.add(&w, sizeof w);
@@ -124,11 +124,12 @@ concept eigen_fixed = requires {
   typename T::Scalar;
   T::RowsAtCompileTime;
   T::ColsAtCompileTime;
-} && std::is_same_v<typename T::Scalar, double> && (T::RowsAtCompileTime > 0) && (T::ColsAtCompileTime > 0);
+}
+&&std::is_same_v<typename T::Scalar, double> && (T::RowsAtCompileTime > 0) && (T::ColsAtCompileTime > 0);
 template <class T>
 concept quaternion = std::is_same_v<T, Eigen::Quaterniond>;
 template <class T>
-concept integer_like = (std::is_integral_v<T> || std::is_enum_v<T>) && !std::is_same_v<T, bool>;
+concept integer_like = (std::is_integral_v<T> || std::is_enum_v<T>)&&!std::is_same_v<T, bool>;
 template <class T>
 struct is_vector : std::false_type {};
 template <class T, class A>
@@ -205,14 +206,15 @@ class output_archive {
         const std::int64_t w = ckpt::to_i64(x);
         raw(&w, sizeof w);
       }
-    } else if constexpr (requires(output_archive& a, const U& u) { U::serialize(a, u); }) {
+    } else if constexpr (requires(output_archive & a, const U& u) { U::serialize(a, u); }) {
       const std::size_t keep = prefix_.size();
       prefix_.append(name).push_back('.');
       U::serialize(*this, v);
       prefix_.resize(keep);
     } else {
-      static_assert(std::is_empty_v<U>, "io::output_archive: this type holds state but has no "
-                                        "`template <class Archive, class Self> static void serialize(Archive&, Self&)`");
+      static_assert(std::is_empty_v<U>,
+                    "io::output_archive: this type holds state but has no "
+                    "`template <class Archive, class Self> static void serialize(Archive&, Self&)`");
     }
   }
   void operator()(std::string_view name, const char* v) { (*this)(name, std::string(v)); }
@@ -307,14 +309,15 @@ class input_archive {
         take(&w, sizeof w);
         x = ckpt::from_i64<typename T::value_type>(w);
       }
-    } else if constexpr (requires(input_archive& a, T& u) { T::serialize(a, u); }) {
+    } else if constexpr (requires(input_archive & a, T & u) { T::serialize(a, u); }) {
       const std::size_t keep = prefix_.size();
       prefix_.append(name).push_back('.');
       T::serialize(*this, v);
       prefix_.resize(keep);
     } else {
-      static_assert(std::is_empty_v<T>, "io::input_archive: this type holds state but has no "
-                                        "`template <class Archive, class Self> static void serialize(Archive&, Self&)`");
+      static_assert(std::is_empty_v<T>,
+                    "io::input_archive: this type holds state but has no "
+                    "`template <class Archive, class Self> static void serialize(Archive&, Self&)`");
     }
   }
 
@@ -345,8 +348,7 @@ class input_archive {
         fail(describe, " differs (", file.size(), " values in the file, ", here.size(), " here)");
     } else {
       if (!ckpt::same_value(file, static_cast<const U&>(here)))
-        fail(describe, " is ", ckpt::show(file), " in the file but ", ckpt::show(static_cast<const U&>(here)),
-             " here");
+        fail(describe, " is ", ckpt::show(file), " in the file but ", ckpt::show(static_cast<const U&>(here)), " here");
     }
   }
   template <class F>
@@ -443,9 +445,18 @@ class input_archive {
       }
       std::uint64_t cnt = 0;
       switch (k) {
-        case 'i': case 'd': p += 8; break;
-        case 's': case 'B': std::memcpy(&cnt, b_.data() + p, 8); p += 8 + std::size_t(cnt); break;
-        case 'D': case 'I': std::memcpy(&cnt, b_.data() + p, 8); p += 8 + 8 * std::size_t(cnt); break;
+        case 'i':
+        case 'd': p += 8; break;
+        case 's':
+        case 'B':
+          std::memcpy(&cnt, b_.data() + p, 8);
+          p += 8 + std::size_t(cnt);
+          break;
+        case 'D':
+        case 'I':
+          std::memcpy(&cnt, b_.data() + p, 8);
+          p += 8 + 8 * std::size_t(cnt);
+          break;
         default: return std::nullopt;
       }
     }
@@ -546,14 +557,24 @@ class checkpoint_file {
           order_.push_back(name);
           open.clear();
           break;
-        case 'i': case 'd': need(8); p += 8; break;
-        case 's': case 'B':
-          need(8); std::memcpy(&cnt, data_.data() + p, 8); p += 8;
+        case 'i':
+        case 'd':
+          need(8);
+          p += 8;
+          break;
+        case 's':
+        case 'B':
+          need(8);
+          std::memcpy(&cnt, data_.data() + p, 8);
+          p += 8;
           if (cnt > n - p) fail("malformed entry '", name, "'");
           p += std::size_t(cnt);
           break;
-        case 'D': case 'I':
-          need(8); std::memcpy(&cnt, data_.data() + p, 8); p += 8;
+        case 'D':
+        case 'I':
+          need(8);
+          std::memcpy(&cnt, data_.data() + p, 8);
+          p += 8;
           if (cnt > (n - p) / 8) fail("malformed entry '", name, "'");
           p += std::size_t(cnt) * 8;
           break;

@@ -15,10 +15,9 @@
 /// `checkpoint_section`, e.g. io::drop_history_record: section "history").
 /// The k-th solver goes to the section "fluid" (k = 0) or "fluid.k", the k-th assembly
 /// to "structure"/"structure.k"; a stepper writes its fluid and its structure there and
-/// its own clock and coupling to "stepper"; a scene signature to "scene". Loading reads the sections its arguments need and ignores the
-/// others (a stepper's fluid and assembly may also be loaded on their own, and a stepper
-/// built from them afterwards: its clock then starts at the fluid's time and its first
-/// coupling kick uses its first substep).
+/// its own clock and coupling to "stepper"; a scene signature to "scene". Loading reads the sections its arguments need
+/// and ignores the others (a stepper's fluid and assembly may also be loaded on their own, and a stepper built from
+/// them afterwards: its clock then starts at the fluid's time and its first coupling kick uses its first substep).
 ///
 /// What is stored is what each component's `serialize` says (io/archive.hpp explains the
 /// archive; every entry is named, fields by their SoA tag names):
@@ -84,11 +83,12 @@ class scene_signature {
   scene_signature& add(std::string name, std::string v) { return put(std::move(name), value(std::move(v))); }
   scene_signature& add(std::string name, const char* v) { return put(std::move(name), value(std::string(v))); }
   template <class I>
-    requires(std::is_integral_v<I> && !std::is_same_v<I, bool>)
-  scene_signature& add(std::string name, I v) {
+  requires(std::is_integral_v<I> && !std::is_same_v<I, bool>) scene_signature& add(std::string name, I v) {
     return put(std::move(name), value(std::int64_t(v)));
   }
-  scene_signature& add(std::string name, bool v) { return put(std::move(name), value(std::string(v ? "true" : "false"))); }
+  scene_signature& add(std::string name, bool v) {
+    return put(std::move(name), value(std::string(v ? "true" : "false")));
+  }
 
   const std::vector<std::pair<std::string, value>>& entries() const noexcept { return entries_; }
 
@@ -159,7 +159,9 @@ concept coupled_stepper = requires(const T& s) {
 /// A component that names its own section (`static constexpr const char* checkpoint_section`),
 /// e.g. io::drop_history_record: the program's records beside the physical state.
 template <class T>
-concept named_section = requires { T::checkpoint_section; };
+concept named_section = requires {
+  T::checkpoint_section;
+};
 
 inline std::string fluid_section(int k) { return k == 0 ? std::string("fluid") : "fluid." + std::to_string(k); }
 inline std::string structure_section(int k) {
@@ -205,9 +207,9 @@ void save_checkpoint(const std::filesystem::path& path, const Parts&... parts) {
   output_archive ar;
   ckpt::for_each_section(
       [&](const std::string& section, const auto& obj) {
-        ar.begin_section(section);
-        std::remove_cvref_t<decltype(obj)>::serialize(ar, obj);
-        ar.end_section(section);
+    ar.begin_section(section);
+    std::remove_cvref_t<decltype(obj)>::serialize(ar, obj);
+    ar.end_section(section);
       },
       parts...);
   write_checkpoint_file(path, ar);
@@ -222,9 +224,9 @@ void load_checkpoint(const std::filesystem::path& path, Parts&... parts) {
   const checkpoint_file file(path);
   ckpt::for_each_section(
       [&](const std::string& section, auto& obj) {
-        input_archive ar = file.section(section);
-        std::remove_cvref_t<decltype(obj)>::serialize(ar, obj);
-        ar.finish();
+    input_archive ar = file.section(section);
+    std::remove_cvref_t<decltype(obj)>::serialize(ar, obj);
+    ar.finish();
       },
       parts...);
 }

@@ -36,10 +36,10 @@ namespace parafsi::io {
 enum class flush_policy { every_row, every_n_rows, interval, on_close };
 
 struct csv_options {
-  int precision = 17;                     ///< significant digits
+  int precision = 17;  ///< significant digits
   flush_policy flush = flush_policy::every_row;
-  long flush_rows = 100;                  ///< for every_n_rows
-  double flush_interval = 1.0;            ///< wall seconds, for interval
+  long flush_rows = 100;        ///< for every_n_rows
+  double flush_interval = 1.0;  ///< wall seconds, for interval
   /// Resume an existing file: keep rows with first column <= this value and append.
   /// NaN (default): truncate and start a new file.
   double resume_after = std::numeric_limits<double>::quiet_NaN();
@@ -48,8 +48,14 @@ struct csv_options {
 namespace detail {
 /// Locale-independent shortest-enough formatting of a double.
 inline void append_number(std::string& s, double v, int precision) {
-  if (std::isnan(v)) { s += "nan"; return; }
-  if (std::isinf(v)) { s += v > 0 ? "inf" : "-inf"; return; }
+  if (std::isnan(v)) {
+    s += "nan";
+    return;
+  }
+  if (std::isinf(v)) {
+    s += v > 0 ? "inf" : "-inf";
+    return;
+  }
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.*g", precision, v);
   for (char* p = buf; *p; ++p)

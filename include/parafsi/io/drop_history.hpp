@@ -84,8 +84,12 @@ class drop_observer {
     drop_history_row r;
     r.t = t;
     const Eigen::Vector3d x = body.mass_centre(), v = body.mass_centre_velocity();
-    r.x = x.x(); r.y = x.y(); r.z = x.z();
-    r.vx = v.x(); r.vy = v.y(); r.vz = v.z();
+    r.x = x.x();
+    r.y = x.y();
+    r.z = x.z();
+    r.vx = v.x();
+    r.vy = v.y();
+    r.vz = v.z();
     r.speed = v.norm();
     for (std::size_t k = 0; k < skirt_x_.size(); ++k) skirt_x_[k] = nd.position(skirt_[k]);
     const Eigen::Vector3d conf = nd.position(confluence_), vent = vent_point(nd);
@@ -93,8 +97,10 @@ class drop_observer {
     r.open_force = std::max(0.0, structure::riser(a).tension(nd, riser_last_));
     const auto pa = axis_angles(body.rotation() * Eigen::Vector3d::UnitZ());
     const auto ca = axis_angles((vent - conf).normalized());
-    r.payload_phi_x = pa[0]; r.payload_phi_y = pa[1];
-    r.canopy_phi_x = ca[0]; r.canopy_phi_y = ca[1];
+    r.payload_phi_x = pa[0];
+    r.payload_phi_y = pa[1];
+    r.canopy_phi_x = ca[0];
+    r.canopy_phi_y = ca[1];
     r.flight_path_angle = flight_path_angle(v, release_flight_path_);
     r.drag_coefficient = drag_coefficient(weight_, air_density_, r.speed, nominal_area_);
     for (index_t i = 0; i < nd.size(); ++i)
@@ -150,9 +156,22 @@ inline void write_drop_summary(const std::filesystem::path& path, const drop_sum
 inline std::vector<drop_history_row> parse_drop_history(std::string_view text, const std::string& source,
                                                         double t_max) {
   std::vector<drop_history_row> rows;
-  static constexpr std::array<const char*, drop_history_row::columns> names{
-      "t", "x", "y", "z", "vx", "vy", "vz", "speed", "canopy_diameter", "open_force", "payload_phi_x",
-      "payload_phi_y", "canopy_phi_x", "canopy_phi_y", "flight_path_angle", "drag_coefficient"};
+  static constexpr std::array<const char*, drop_history_row::columns> names{"t",
+                                                                            "x",
+                                                                            "y",
+                                                                            "z",
+                                                                            "vx",
+                                                                            "vy",
+                                                                            "vz",
+                                                                            "speed",
+                                                                            "canopy_diameter",
+                                                                            "open_force",
+                                                                            "payload_phi_x",
+                                                                            "payload_phi_y",
+                                                                            "canopy_phi_x",
+                                                                            "canopy_phi_y",
+                                                                            "flight_path_angle",
+                                                                            "drag_coefficient"};
   std::size_t pos = 0;
   long line_no = 0;
   while (pos < text.size()) {
@@ -178,8 +197,8 @@ inline std::vector<drop_history_row> parse_drop_history(std::string_view text, c
       double x = 0;
       const auto res = std::from_chars(item.data(), item.data() + item.size(), x);
       require(!item.empty() && res.ec == std::errc{} && res.ptr == item.data() + item.size(),
-              "io::read_drop_history: '", source, "' line ", line_no, ", column ", k + 1, " (", names[k], "): '",
-              item, "' is not a number");
+              "io::read_drop_history: '", source, "' line ", line_no, ", column ", k + 1, " (", names[k], "): '", item,
+              "' is not a number");
       v[k++] = x;
       if (comma == std::string_view::npos) break;
       start = comma + 1;

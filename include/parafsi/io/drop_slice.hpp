@@ -38,9 +38,8 @@ inline std::string drop_slice_stem(double t_label) {
 
 /// Write the slice of `fluid` at label time `t_label` into `dir` (rules in the file comment).
 template <class Fluid>
-void write_drop_slice(const std::filesystem::path& dir, double t_label, const Fluid& fluid,
-                      const structure::nodes& nd, index_t canopy_nodes, const Eigen::Vector3d& payload_velocity,
-                      double pressure_offset) {
+void write_drop_slice(const std::filesystem::path& dir, double t_label, const Fluid& fluid, const structure::nodes& nd,
+                      index_t canopy_nodes, const Eigen::Vector3d& payload_velocity, double pressure_offset) {
   const auto& g = fluid.grid();
   const auto& pose = fluid.pose();
   const Eigen::Matrix3d Rt = pose.R.transpose();

@@ -65,14 +65,41 @@ struct drop_history_row {
 
   static constexpr std::size_t columns = 16;
   std::array<double, columns> values() const {
-    return {t, x, y, z, vx, vy, vz, speed, canopy_diameter, open_force, payload_phi_x, payload_phi_y, canopy_phi_x,
-            canopy_phi_y, flight_path_angle, drag_coefficient};
+    return {t,
+            x,
+            y,
+            z,
+            vx,
+            vy,
+            vz,
+            speed,
+            canopy_diameter,
+            open_force,
+            payload_phi_x,
+            payload_phi_y,
+            canopy_phi_x,
+            canopy_phi_y,
+            flight_path_angle,
+            drag_coefficient};
   }
   static drop_history_row from(const std::array<double, columns>& v) {
     drop_history_row r;
-    r.t = v[0]; r.x = v[1]; r.y = v[2]; r.z = v[3]; r.vx = v[4]; r.vy = v[5]; r.vz = v[6]; r.speed = v[7];
-    r.canopy_diameter = v[8]; r.open_force = v[9]; r.payload_phi_x = v[10]; r.payload_phi_y = v[11];
-    r.canopy_phi_x = v[12]; r.canopy_phi_y = v[13]; r.flight_path_angle = v[14]; r.drag_coefficient = v[15];
+    r.t = v[0];
+    r.x = v[1];
+    r.y = v[2];
+    r.z = v[3];
+    r.vx = v[4];
+    r.vy = v[5];
+    r.vz = v[6];
+    r.speed = v[7];
+    r.canopy_diameter = v[8];
+    r.open_force = v[9];
+    r.payload_phi_x = v[10];
+    r.payload_phi_y = v[11];
+    r.canopy_phi_x = v[12];
+    r.canopy_phi_y = v[13];
+    r.flight_path_angle = v[14];
+    r.drag_coefficient = v[15];
     return r;
   }
 };

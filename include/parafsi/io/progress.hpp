@@ -32,7 +32,7 @@
 namespace parafsi::io {
 
 struct progress_options {
-  double interval = 0.5;          ///< minimum wall seconds between two lines
+  double interval = 0.5;           ///< minimum wall seconds between two lines
   std::ostream* out = &std::cerr;  ///< where lines go (stderr by default)
   bool carriage_return = false;    ///< '\r' instead of '\n' (one rewritten terminal line)
   std::string prefix;              ///< text before every line, e.g. the run's name

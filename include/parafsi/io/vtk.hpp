@@ -90,7 +90,7 @@ struct vtu_options : vtk_options {
 };
 
 struct midplane_options {
-  int normal_axis = 1;  ///< box axis normal to the plane (0, 1 or 2)
+  int normal_axis = 1;                                         ///< box axis normal to the plane (0, 1 or 2)
   double position = std::numeric_limits<double>::quiet_NaN();  ///< ξ of the plane; NaN = mid-box
 };
 
@@ -107,7 +107,10 @@ inline std::string base64(const unsigned char* p, std::size_t n) {
   std::size_t i = 0;
   for (; i + 2 < n; i += 3) {
     const unsigned v = (unsigned(p[i]) << 16) | (unsigned(p[i + 1]) << 8) | unsigned(p[i + 2]);
-    s += tbl[(v >> 18) & 63]; s += tbl[(v >> 12) & 63]; s += tbl[(v >> 6) & 63]; s += tbl[v & 63];
+    s += tbl[(v >> 18) & 63];
+    s += tbl[(v >> 12) & 63];
+    s += tbl[(v >> 6) & 63];
+    s += tbl[v & 63];
   }
   if (i < n) {
     unsigned v = unsigned(p[i]) << 16;
@@ -120,11 +123,24 @@ inline std::string base64(const unsigned char* p, std::size_t n) {
   return s;
 }
 
-template <class T> constexpr const char* vtk_type_name();
-template <> constexpr const char* vtk_type_name<double>() { return "Float64"; }
-template <> constexpr const char* vtk_type_name<std::int64_t>() { return "Int64"; }
-template <> constexpr const char* vtk_type_name<std::int32_t>() { return "Int32"; }
-template <> constexpr const char* vtk_type_name<std::uint8_t>() { return "UInt8"; }
+template <class T>
+constexpr const char* vtk_type_name();
+template <>
+constexpr const char* vtk_type_name<double>() {
+  return "Float64";
+}
+template <>
+constexpr const char* vtk_type_name<std::int64_t>() {
+  return "Int64";
+}
+template <>
+constexpr const char* vtk_type_name<std::int32_t>() {
+  return "Int32";
+}
+template <>
+constexpr const char* vtk_type_name<std::uint8_t>() {
+  return "UInt8";
+}
 
 /// Appends <DataArray> elements in the chosen encoding.
 class xml_out {
@@ -138,7 +154,11 @@ class xml_out {
     s += "<DataArray type=\"";
     s += vtk_type_name<T>();
     s += "\"";
-    if (!name.empty()) { s += " Name=\""; s += name; s += "\""; }
+    if (!name.empty()) {
+      s += " Name=\"";
+      s += name;
+      s += "\"";
+    }
     if (components > 1) s += " NumberOfComponents=\"" + std::to_string(components) + "\"";
     s += enc_ == vtk_encoding::ascii ? " format=\"ascii\">\n" : " format=\"binary\">\n";
     s.append(std::size_t(indent + 2), ' ');
@@ -200,7 +220,8 @@ template <class Assembly, class F>
 void for_each_part(const Assembly& a, F&& f) {
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     (f(std::integral_constant<std::size_t, I>{}, a.template part<I>()), ...);
-  }(std::make_index_sequence<Assembly::part_count>{});
+  }
+  (std::make_index_sequence<Assembly::part_count>{});
 }
 
 }  // namespace detail
@@ -288,7 +309,8 @@ void write_vtu(const std::filesystem::path& path, const Assembly& a, const vtu_o
   s += "      <PointData Vectors=\"velocity\">\n" + x.s + "      </PointData>\n";
   x.s.clear();
   x.array("part", 1, part, 8);
-  if (!opt.cell_tags.empty()) x.array("tag", 1, std::vector<std::int32_t>(opt.cell_tags.begin(), opt.cell_tags.end()), 8);
+  if (!opt.cell_tags.empty())
+    x.array("tag", 1, std::vector<std::int32_t>(opt.cell_tags.begin(), opt.cell_tags.end()), 8);
   x.array("stress", 3, stress, 8);
   x.array("effective_stress", 1, eff, 8);
   x.array("strain", 3, strain, 8);
@@ -341,7 +363,9 @@ std::vector<double> vorticity(const Solver& s) {
         const Eigen::Vector3d wb(G(2, 1) - G(1, 2), G(0, 2) - G(2, 0), G(1, 0) - G(0, 1));
         const Eigen::Vector3d wi = R * wb;
         const std::size_t c = lin(i, j, k);
-        out[3 * c] = wi.x(); out[3 * c + 1] = wi.y(); out[3 * c + 2] = wi.z();
+        out[3 * c] = wi.x();
+        out[3 * c + 1] = wi.y();
+        out[3 * c + 2] = wi.z();
       }
   return out;
 }
@@ -362,7 +386,9 @@ void write_vts(const std::filesystem::path& path, const Solver& s, const vtk_opt
       }
   const std::size_t cells = std::size_t(n[0] * n[1] * n[2]);
   std::vector<double> rho, vel, p, mut;
-  rho.reserve(cells); vel.reserve(3 * cells); p.reserve(cells);
+  rho.reserve(cells);
+  vel.reserve(3 * cells);
+  p.reserve(cells);
   for (index_t k = 0; k < n[2]; ++k)
     for (index_t j = 0; j < n[1]; ++j)
       for (index_t i = 0; i < n[0]; ++i) {
@@ -442,9 +468,13 @@ std::size_t write_midplane_csv(const std::filesystem::path& path, const Solver& 
       xi[b] = g.centre(b, jb);
       xi[c] = g.centre(c, jc);
       const Eigen::Vector3d x = pose.to_inertial(xi);
-      num(x.x(), false); num(x.y(), false); num(x.z(), false);
+      num(x.x(), false);
+      num(x.y(), false);
+      num(x.z(), false);
       num(mix(p0.rho, p1.rho), false);
-      num(mix(p0.u.x, p1.u.x), false); num(mix(p0.u.y, p1.u.y), false); num(mix(p0.u.z, p1.u.z), false);
+      num(mix(p0.u.x, p1.u.x), false);
+      num(mix(p0.u.y, p1.u.y), false);
+      num(mix(p0.u.z, p1.u.z), false);
       num(mix(p0.p, p1.p), false);
       num(om.dot(nrm), true);
       ++rows;

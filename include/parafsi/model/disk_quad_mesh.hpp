@@ -30,7 +30,8 @@ struct disk_quadrangulation {
 inline disk_quadrangulation disk_quad_mesh(double R, int n, int m = 0, double inner = 0.5, double z0 = 0.0) {
   require(R > 0 && std::isfinite(R), "model::disk_quad_mesh: radius must be > 0, got ", R);
   require(n >= 2 && n % 2 == 0, "model::disk_quad_mesh: n must be even and >= 2, got ", n);
-  require(inner > 0.1 && inner < 0.7, "model::disk_quad_mesh: inner square fraction must be in (0.1, 0.7), got ", inner);
+  require(inner > 0.1 && inner < 0.7, "model::disk_quad_mesh: inner square fraction must be in (0.1, 0.7), got ",
+          inner);
   const double s = inner * R;
   if (m <= 0) m = std::max(1, int(std::lround((R - s) / (2.0 * s / n))));
   disk_quadrangulation d;

@@ -63,17 +63,17 @@ struct drop_resolution {
 };
 
 struct drop_box_parameters {
-  double width = 5.0;            ///< cross-section side / D0
-  double length = 7.0;           ///< length along the axis / D0
-  double ahead = 1.5;            ///< length ahead of the payload mass centre / D0
-  double cell = 0.0667;          ///< cell size h on the refined block / D0
-  double growth = 1.2;           ///< cell growth factor outside the refined block, in [1, 2]
-  double fall = 0.0;             ///< fixed box: fall length (m) below the start it must hold; 0 = following box
-  double refined_radius = 0.6;   ///< refined block half-width / D0
-  double refined_below = 0.55;   ///< refined block start above the confluence / Ls
-  double refined_above = 0.55;   ///< refined block end above the point Ls beyond the confluence / D0
-  double max_cells = 5e7;        ///< largest box accepted (cells)
-  double bytes_per_cell = 300;   ///< memory estimate per cell (for the size message)
+  double width = 5.0;           ///< cross-section side / D0
+  double length = 7.0;          ///< length along the axis / D0
+  double ahead = 1.5;           ///< length ahead of the payload mass centre / D0
+  double cell = 0.0667;         ///< cell size h on the refined block / D0
+  double growth = 1.2;          ///< cell growth factor outside the refined block, in [1, 2]
+  double fall = 0.0;            ///< fixed box: fall length (m) below the start it must hold; 0 = following box
+  double refined_radius = 0.6;  ///< refined block half-width / D0
+  double refined_below = 0.55;  ///< refined block start above the confluence / Ls
+  double refined_above = 0.55;  ///< refined block end above the point Ls beyond the confluence / D0
+  double max_cells = 5e7;       ///< largest box accepted (cells)
+  double bytes_per_cell = 300;  ///< memory estimate per cell (for the size message)
 
   void validate() const {
     auto positive = [](double v) { return v > 0 && std::isfinite(v); };
@@ -92,12 +92,12 @@ struct drop_box_parameters {
 };
 
 struct drop_box {
-  std::array<double, 3> lo{}, hi{};              ///< box extents in box coordinates ξ (m)
-  std::array<double, 3> fine_lo{}, fine_hi{};    ///< refined block (m), inside the extents
-  double cell = 0;                               ///< cell size h on the refined block (m)
-  double growth = 1;                             ///< growth factor outside it
-  double fall = 0;                               ///< fixed box: fall length it holds (m); 0 = following
-  std::array<double, 3> cells_estimate{};        ///< estimated cells per axis (before the grid is built)
+  std::array<double, 3> lo{}, hi{};                    ///< box extents in box coordinates ξ (m)
+  std::array<double, 3> fine_lo{}, fine_hi{};          ///< refined block (m), inside the extents
+  double cell = 0;                                     ///< cell size h on the refined block (m)
+  double growth = 1;                                   ///< growth factor outside it
+  double fall = 0;                                     ///< fixed box: fall length it holds (m); 0 = following
+  std::array<double, 3> cells_estimate{};              ///< estimated cells per axis (before the grid is built)
   Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< box axes (x_b, y_b, z_b) as columns, world
 
   double estimated_cells() const { return cells_estimate[0] * cells_estimate[1] * cells_estimate[2]; }

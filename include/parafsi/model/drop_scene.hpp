@@ -64,17 +64,17 @@ inline constexpr const char* cable_kind_name(cable_kind k) {
 struct drop_scene_parameters {
   std::string name = "paper";
   // Table 3
-  double release_height = 35.0;      ///< payload mass centre height (m)
-  double initial_speed = 0.0;        ///< m/s
-  double flight_path_angle = 90.0;   ///< degrees below the horizontal
-  double air_density = 1.18;         ///< kg/m³
-  double air_pressure = 101325.0;    ///< Pa
-  double air_viscosity = 1.79e-5;    ///< Pa s
-  double gravity = 9.81;             ///< m/s²
+  double release_height = 35.0;     ///< payload mass centre height (m)
+  double initial_speed = 0.0;       ///< m/s
+  double flight_path_angle = 90.0;  ///< degrees below the horizontal
+  double air_density = 1.18;        ///< kg/m³
+  double air_pressure = 101325.0;   ///< Pa
+  double air_viscosity = 1.79e-5;   ///< Pa s
+  double gravity = 9.81;            ///< m/s²
   // §4.1
-  canopy_parameters canopy{};        ///< 8 gores, D0 = 1 m, Dv = 0.1 D0
-  double line_length_ratio = 1.0;    ///< Ls / D0
-  double riser_ratio = 0.08;         ///< Lr / Ls
+  canopy_parameters canopy{};      ///< 8 gores, D0 = 1 m, Dv = 0.1 D0
+  double line_length_ratio = 1.0;  ///< Ls / D0
+  double riser_ratio = 0.08;       ///< Lr / Ls
   int line_segments = 10;
   int riser_segments = 1;
   std::string fabric = "mat544";
@@ -85,7 +85,7 @@ struct drop_scene_parameters {
   line_spec band = line_specs::tape_half_inch;
   double riser_strength_factor = 0;  ///< riser = this many lines in parallel (0: the number of lines)
   payload_parameters payload{};
-  packed_shape shape{};              ///< reduced radius, s = 0.2
+  packed_shape shape{};  ///< reduced radius, s = 0.2
 
   double line_length() const { return line_length_ratio * canopy.nominal_diameter; }
   double riser_length() const { return riser_ratio * line_length(); }
@@ -181,13 +181,13 @@ struct drop_scene {
   membrane_moduli moduli{};
   // Nodes (canopy nodes first, ids as in `canopy`; then confluence, line, riser nodes).
   std::vector<Eigen::Vector3d> positions, velocities;
-  std::vector<Eigen::Vector3d> reference;   ///< stress-free positions of every node (canopy: the cut pattern)
-  std::vector<double> point_mass;           ///< for nodes::add (zero: elements lump their own mass)
-  std::vector<double> lumped_mass;          ///< what the parts will lump (diagnostics)
+  std::vector<Eigen::Vector3d> reference;  ///< stress-free positions of every node (canopy: the cut pattern)
+  std::vector<double> point_mass;          ///< for nodes::add (zero: elements lump their own mass)
+  std::vector<double> lumped_mass;         ///< what the parts will lump (diagnostics)
   // Membrane (one fabric).
   std::vector<std::array<index_t, 3>> triangles;
-  std::vector<Eigen::Vector3d> warp;        ///< per triangle (world axes)
-  std::vector<int> triangle_fabric;         ///< index into `fabrics` (all 0)
+  std::vector<Eigen::Vector3d> warp;  ///< per triangle (world axes)
+  std::vector<int> triangle_fabric;   ///< index into `fabrics` (all 0)
   std::vector<membrane_moduli> fabrics;
   // Lines.
   std::array<cable_set, cable_kind_count> cables;
@@ -195,9 +195,9 @@ struct drop_scene {
   payload_data payload;
   std::vector<attachment_point> attachments;
   // Tags and parts.
-  canopy_mesh canopy;                       ///< the canopy's own data (cut pattern, tags)
-  suspension_mesh suspension;               ///< line / riser paths (node ids)
-  index_t canopy_nodes = 0;                 ///< nodes [0, canopy_nodes) are the canopy's
+  canopy_mesh canopy;                                         ///< the canopy's own data (cut pattern, tags)
+  suspension_mesh suspension;                                 ///< line / riser paths (node ids)
+  index_t canopy_nodes = 0;                                   ///< nodes [0, canopy_nodes) are the canopy's
   Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();  ///< canopy frame → world rotation
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();           ///< canopy frame origin in world
 

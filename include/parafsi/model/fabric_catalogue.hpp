@@ -43,14 +43,14 @@ namespace parafsi::model {
 
 struct fabric_data {
   std::string_view name;
-  double areal_density;      ///< kg/m²
-  double thickness;          ///< m
-  double break_strength;     ///< N per 5 cm strip
-  double elongation;         ///< at break, fraction
-  double air_permeability;   ///< m/s at the test pressure
-  double test_pressure;      ///< Pa
-  double alpha;              ///< Ergun α (kg m⁻³ s⁻¹)
-  double beta;               ///< Ergun β (kg m⁻⁴)
+  double areal_density;     ///< kg/m²
+  double thickness;         ///< m
+  double break_strength;    ///< N per 5 cm strip
+  double elongation;        ///< at break, fraction
+  double air_permeability;  ///< m/s at the test pressure
+  double test_pressure;     ///< Pa
+  double alpha;             ///< Ergun α (kg m⁻³ s⁻¹)
+  double beta;              ///< Ergun β (kg m⁻⁴)
 };
 
 inline constexpr std::array<fabric_data, 3> fabric_catalogue{{
@@ -76,8 +76,8 @@ inline const fabric_data& fabric(std::string_view name) {
     if (f.name == name) return f;
   for (const auto& f : extra_fabrics)
     if (f.name == name) return f;
-  throw invalid_input(detail::concat("model::fabric: unknown fabric '", name,
-                                     "' (known: mat544, mat59225, mat509, c9_mil_c_7020)"));
+  throw invalid_input(
+      detail::concat("model::fabric: unknown fabric '", name, "' (known: mat544, mat59225, mat509, c9_mil_c_7020)"));
 }
 
 /// Strip width of the break-strength test (Table 2 gives N per 5 cm).
@@ -85,9 +85,9 @@ inline constexpr double strip_width = 0.05;
 
 /// Choices for what the fabric data do not give (see the file comment).
 struct moduli_options {
-  double nu12 = 0.2;         ///< major Poisson ratio
-  double weft_ratio = 1.0;   ///< E22 / E11
-  double shear_ratio = 0.0;  ///< G12 / E11; 0 = isotropic-equivalent E11/(2(1+ν12))
+  double nu12 = 0.2;           ///< major Poisson ratio
+  double weft_ratio = 1.0;     ///< E22 / E11
+  double shear_ratio = 0.0;    ///< G12 / E11; 0 = isotropic-equivalent E11/(2(1+ν12))
   double modulus_scale = 1.0;  ///< multiplies E11, E22, G12 (sensitivity studies)
 };
 
@@ -109,8 +109,8 @@ inline double break_force_per_width(const fabric_data& f) { return f.break_stren
 
 /// E·t ≈ (F_b/w)/ε_b, E = E·t / t, and the documented defaults for E22, ν12, G12.
 inline membrane_moduli derived_moduli(const fabric_data& f, const moduli_options& o = {}) {
-  require(f.thickness > 0 && std::isfinite(f.thickness), "model::derived_moduli: fabric '", f.name,
-          "' has thickness ", f.thickness, " (must be > 0)");
+  require(f.thickness > 0 && std::isfinite(f.thickness), "model::derived_moduli: fabric '", f.name, "' has thickness ",
+          f.thickness, " (must be > 0)");
   require(f.elongation > 0 && std::isfinite(f.elongation), "model::derived_moduli: fabric '", f.name,
           "' has elongation at break ", f.elongation, " (must be > 0)");
   require(f.break_strength > 0 && std::isfinite(f.break_strength), "model::derived_moduli: fabric '", f.name,

@@ -63,25 +63,24 @@ namespace parafsi::model {
 enum class diameter_basis { nominal_area, corners };
 
 struct canopy_parameters {
-  int gores = 8;                         ///< N
-  double nominal_diameter = 1.0;         ///< D0 (m)
-  double vent_ratio = 0.1;               ///< Dv/D0, in (0, 1)
+  int gores = 8;                  ///< N
+  double nominal_diameter = 1.0;  ///< D0 (m)
+  double vent_ratio = 0.1;        ///< Dv/D0, in (0, 1)
   diameter_basis basis = diameter_basis::nominal_area;
-  double element_size = 0.05;            ///< target element edge h (m)
-  int radial_divisions = 0;              ///< rows along a seam n_r (0: round((R_s − R_v)/h))
-  double fibre_angle = 0.0;              ///< warp angle from the gore centreline (rad)
-  bool radial_bands = true;              ///< bands along the seams
-  bool bands_cross_vent = true;          ///< bands join opposite seams across the vent (N even)
-  int vent_band_divisions = 0;           ///< segments per half vent crossing (0: from h, >= 1)
-  double max_triangles = 1e8;            ///< largest mesh accepted (estimated before it is built)
+  double element_size = 0.05;    ///< target element edge h (m)
+  int radial_divisions = 0;      ///< rows along a seam n_r (0: round((R_s − R_v)/h))
+  double fibre_angle = 0.0;      ///< warp angle from the gore centreline (rad)
+  bool radial_bands = true;      ///< bands along the seams
+  bool bands_cross_vent = true;  ///< bands join opposite seams across the vent (N even)
+  int vent_band_divisions = 0;   ///< segments per half vent crossing (0: from h, >= 1)
+  double max_triangles = 1e8;    ///< largest mesh accepted (estimated before it is built)
 
   void validate() const {
     require(gores >= 3, "model::flat_circular_canopy: need at least 3 gores, got ", gores);
     require(nominal_diameter > 0 && std::isfinite(nominal_diameter),
             "model::flat_circular_canopy: nominal diameter D0 must be > 0, got ", nominal_diameter);
     require(vent_ratio > 0 && vent_ratio < 1 && std::isfinite(vent_ratio),
-            "model::flat_circular_canopy: vent ratio Dv/D0 must be in (0, 1) (vent smaller than D0), got ",
-            vent_ratio);
+            "model::flat_circular_canopy: vent ratio Dv/D0 must be in (0, 1) (vent smaller than D0), got ", vent_ratio);
     require(element_size > 0 && std::isfinite(element_size),
             "model::flat_circular_canopy: element size must be > 0, got ", element_size);
     require(radial_divisions >= 0, "model::flat_circular_canopy: radial divisions must be >= 0, got ",
@@ -95,9 +94,8 @@ struct canopy_parameters {
     const double rows = radial_divisions > 0 ? double(radial_divisions) : std::max(1.0, (Rs - Rv) / element_size);
     const double segments = std::max(1.0, Rs * std::sin(std::numbers::pi / gores) / element_size);
     const double triangles = 4.0 * gores * rows * segments;
-    require(triangles <= max_triangles, "model::flat_circular_canopy: element size ", element_size,
-            " m would give ", float_text(triangles), " triangles, more than the limit of ", max_triangles,
-            ": use a larger element size");
+    require(triangles <= max_triangles, "model::flat_circular_canopy: element size ", element_size, " m would give ",
+            float_text(triangles), " triangles, more than the limit of ", max_triangles, ": use a larger element size");
   }
   /// An estimated count in 3 significant digits (for messages).
   static std::string float_text(double v) {
@@ -118,25 +116,24 @@ struct canopy_parameters {
 
 /// Bits of `canopy_mesh::node_tag`.
 namespace canopy_tag {
-inline constexpr unsigned skirt = 1u, vent = 2u, seam = 4u, centreline = 8u, line_attachment = 16u,
-                        vent_centre = 32u;
+inline constexpr unsigned skirt = 1u, vent = 2u, seam = 4u, centreline = 8u, line_attachment = 16u, vent_centre = 32u;
 }
 
 struct canopy_mesh {
   canopy_parameters params;
-  double skirt_radius = 0;  ///< R_s, skirt corner radius (m)
-  double vent_radius = 0;   ///< R_v, vent corner radius (m)
-  std::vector<Eigen::Vector3d> positions;             ///< the flat cut pattern (z = 0)
-  std::vector<std::array<index_t, 3>> triangles;      ///< counter-clockwise about +z
-  std::vector<Eigen::Vector3d> warp;                  ///< warp direction per triangle
-  std::vector<int> gore;                              ///< gore of each triangle
-  std::vector<unsigned> node_tag;                     ///< canopy_tag bits per node
-  std::vector<index_t> skirt, vent;                   ///< closed loops, counter-clockwise
-  std::vector<std::vector<index_t>> seams;            ///< seam k: vent corner → skirt corner
-  std::vector<std::vector<index_t>> centrelines;      ///< gore k: vent → skirt
-  std::vector<index_t> line_attachment;               ///< skirt corner of seam k (line k)
-  index_t vent_centre = -1;                           ///< band crossing node, −1 if none
-  std::vector<std::vector<index_t>> bands;            ///< node paths of the radial bands
+  double skirt_radius = 0;                        ///< R_s, skirt corner radius (m)
+  double vent_radius = 0;                         ///< R_v, vent corner radius (m)
+  std::vector<Eigen::Vector3d> positions;         ///< the flat cut pattern (z = 0)
+  std::vector<std::array<index_t, 3>> triangles;  ///< counter-clockwise about +z
+  std::vector<Eigen::Vector3d> warp;              ///< warp direction per triangle
+  std::vector<int> gore;                          ///< gore of each triangle
+  std::vector<unsigned> node_tag;                 ///< canopy_tag bits per node
+  std::vector<index_t> skirt, vent;               ///< closed loops, counter-clockwise
+  std::vector<std::vector<index_t>> seams;        ///< seam k: vent corner → skirt corner
+  std::vector<std::vector<index_t>> centrelines;  ///< gore k: vent → skirt
+  std::vector<index_t> line_attachment;           ///< skirt corner of seam k (line k)
+  index_t vent_centre = -1;                       ///< band crossing node, −1 if none
+  std::vector<std::vector<index_t>> bands;        ///< node paths of the radial bands
   std::vector<std::array<index_t, 2>> skirt_tape, vent_tape, band_segments;
 
   index_t node_count() const { return index_t(positions.size()); }
@@ -230,7 +227,8 @@ inline canopy_mesh flat_circular_canopy(const canopy_parameters& p = {}) {
   std::vector<std::vector<index_t>> skirt_parts, vent_parts;
   for (int k = 0; k < N; ++k) {
     const Eigen::Vector3d nmid = (e(k) + e(k + 1)).normalized();
-    const Eigen::Vector3d warp = std::cos(p.fibre_angle) * nmid + std::sin(p.fibre_angle) * Eigen::Vector3d::UnitZ().cross(nmid);
+    const Eigen::Vector3d warp = std::cos(p.fibre_angle) * nmid +
+                                 std::sin(p.fibre_angle) * Eigen::Vector3d::UnitZ().cross(nmid);
     for (int half = 0; half < 2; ++half) {
       std::vector<std::vector<index_t>> rows(std::size_t(nr) + 1);
       std::vector<std::vector<double>> us(std::size_t(nr) + 1);
@@ -239,7 +237,8 @@ inline canopy_mesh flat_circular_canopy(const canopy_parameters& p = {}) {
         const Eigen::Vector3d A = r_of(i) * e(k), B = r_of(i) * e(k + 1);
         auto& row = rows[std::size_t(i)];
         auto& u = us[std::size_t(i)];
-        const index_t first = half == 0 ? c.seams[std::size_t(k)][std::size_t(i)] : c.centrelines[std::size_t(k)][std::size_t(i)];
+        const index_t first = half == 0 ? c.seams[std::size_t(k)][std::size_t(i)]
+                                        : c.centrelines[std::size_t(k)][std::size_t(i)];
         const index_t last = half == 0 ? c.centrelines[std::size_t(k)][std::size_t(i)]
                                        : c.seams[std::size_t((k + 1) % N)][std::size_t(i)];
         row.push_back(first);
@@ -255,16 +254,14 @@ inline canopy_mesh flat_circular_canopy(const canopy_parameters& p = {}) {
       for (int i = 0; i < nr; ++i)
         detail::merge_rows(rows[std::size_t(i)], us[std::size_t(i)], rows[std::size_t(i) + 1], us[std::size_t(i) + 1],
                            [&](index_t a, index_t b, index_t d) {
-                             std::array<index_t, 3> t{a, b, d};
-                             const auto& X = c.positions;
-                             const double z = (X[std::size_t(b)] - X[std::size_t(a)])
-                                                  .cross(X[std::size_t(d)] - X[std::size_t(a)])
-                                                  .z();
-                             if (z < 0) std::swap(t[1], t[2]);
-                             c.triangles.push_back(t);
-                             c.warp.push_back(warp);
-                             c.gore.push_back(k);
-                           });
+          std::array<index_t, 3> t{a, b, d};
+          const auto& X = c.positions;
+          const double z = (X[std::size_t(b)] - X[std::size_t(a)]).cross(X[std::size_t(d)] - X[std::size_t(a)]).z();
+          if (z < 0) std::swap(t[1], t[2]);
+          c.triangles.push_back(t);
+          c.warp.push_back(warp);
+          c.gore.push_back(k);
+        });
       auto sk = rows[std::size_t(nr)];
       auto vt = rows[0];
       sk.pop_back();
@@ -275,7 +272,8 @@ inline canopy_mesh flat_circular_canopy(const canopy_parameters& p = {}) {
   }
   for (const auto& s : skirt_parts) c.skirt.insert(c.skirt.end(), s.begin(), s.end());
   for (const auto& s : vent_parts) c.vent.insert(c.vent.end(), s.begin(), s.end());
-  for (std::size_t a = 0; a < c.skirt.size(); ++a) c.skirt_tape.push_back({c.skirt[a], c.skirt[(a + 1) % c.skirt.size()]});
+  for (std::size_t a = 0; a < c.skirt.size(); ++a)
+    c.skirt_tape.push_back({c.skirt[a], c.skirt[(a + 1) % c.skirt.size()]});
   for (std::size_t a = 0; a < c.vent.size(); ++a) c.vent_tape.push_back({c.vent[a], c.vent[(a + 1) % c.vent.size()]});
   for (int k = 0; k < N; ++k) c.line_attachment.push_back(c.seams[std::size_t(k)].back());
 

@@ -41,8 +41,8 @@ enum class packed_kind { constructed, reduced_radius, star_fold };
 
 struct packed_shape {
   packed_kind kind = packed_kind::reduced_radius;
-  double scale = 0.2;                                        ///< s of reduced_radius
-  double seam_half_angle = 5.0 * std::numbers::pi / 180.0;   ///< θ_s of star_fold (rad)
+  double scale = 0.2;                                       ///< s of reduced_radius
+  double seam_half_angle = 5.0 * std::numbers::pi / 180.0;  ///< θ_s of star_fold (rad)
 
   static packed_shape constructed() { return {packed_kind::constructed, 1.0, 0.0}; }
   static packed_shape reduced_radius(double s) { return {packed_kind::reduced_radius, s, 0.0}; }

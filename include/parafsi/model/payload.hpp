@@ -22,7 +22,7 @@
 namespace parafsi::model {
 
 struct payload_parameters {
-  double mass = 1.8;                                   ///< kg
+  double mass = 1.8;                                         ///< kg
   Eigen::Vector3d size = Eigen::Vector3d(0.15, 0.15, 0.10);  ///< edge lengths a, b, c (m), c along the axis
 
   void validate() const {
@@ -35,11 +35,11 @@ struct payload_parameters {
 struct payload_data {
   double mass = 0;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();
-  Eigen::Vector3d inertia_diagonal = Eigen::Vector3d::Zero();   ///< about the mass centre, body axes (kg m²)
-  Eigen::Vector3d hanging_point = Eigen::Vector3d::Zero();      ///< r_T, body axes (m)
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();           ///< mass centre, world (m)
-  Eigen::Quaterniond attitude = Eigen::Quaterniond::Identity(); ///< body → world
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();           ///< m/s
+  Eigen::Vector3d inertia_diagonal = Eigen::Vector3d::Zero();    ///< about the mass centre, body axes (kg m²)
+  Eigen::Vector3d hanging_point = Eigen::Vector3d::Zero();       ///< r_T, body axes (m)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();            ///< mass centre, world (m)
+  Eigen::Quaterniond attitude = Eigen::Quaterniond::Identity();  ///< body → world
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();            ///< m/s
   /// World position of the hanging point.
   Eigen::Vector3d hanging_point_world() const { return position + attitude * hanging_point; }
 };

@@ -73,31 +73,31 @@ struct line_spec {
 
 namespace line_specs {
 inline constexpr line_spec mil_c_5040_type_i{"MIL-C-5040 Type I nylon cord (95 lb)", 423.0, 0.30, 1.6e-3, 0.1, 1.0};
-inline constexpr line_spec mil_c_5040_type_iii{"MIL-C-5040 Type III nylon cord (550 lb)", 2447.0, 0.30, 6.6e-3, 0.1,
-                                               1.0};
+inline constexpr line_spec mil_c_5040_type_iii{
+    "MIL-C-5040 Type III nylon cord (550 lb)", 2447.0, 0.30, 6.6e-3, 0.1, 1.0};
 inline constexpr line_spec tape_half_inch{"1/2-in nylon tape, 500 lb (assumed)", 2224.0, 0.25, 5.0e-3, 0.1, 1.0};
 inline constexpr line_spec tape_one_inch{"1-in nylon tape, 1000 lb (assumed)", 4448.0, 0.25, 12.0e-3, 0.1, 1.0};
 }  // namespace line_specs
 
 struct suspension_parameters {
-  double line_length = 1.0;   ///< Ls (m), attachment → confluence
-  int line_segments = 10;     ///< segments per line
-  double riser_length = 0.08; ///< Lr (m), confluence → hanging point
+  double line_length = 1.0;    ///< Ls (m), attachment → confluence
+  int line_segments = 10;      ///< segments per line
+  double riser_length = 0.08;  ///< Lr (m), confluence → hanging point
   int riser_segments = 1;
 
   void validate() const {
     require(line_length > 0 && std::isfinite(line_length), "model::suspension_lines: line length Ls must be > 0, got ",
             line_length);
     require(line_segments >= 1, "model::suspension_lines: need at least 1 segment per line, got ", line_segments);
-    require(riser_length > 0 && std::isfinite(riser_length),
-            "model::suspension_lines: riser length must be > 0, got ", riser_length);
+    require(riser_length > 0 && std::isfinite(riser_length), "model::suspension_lines: riser length must be > 0, got ",
+            riser_length);
     require(riser_segments >= 1, "model::suspension_lines: need at least 1 riser segment, got ", riser_segments);
   }
 };
 
 struct suspension_mesh {
-  std::vector<std::vector<index_t>> lines;          ///< line k: attachment k → confluence (node path)
-  std::vector<index_t> riser;                       ///< confluence → hanging point
+  std::vector<std::vector<index_t>> lines;  ///< line k: attachment k → confluence (node path)
+  std::vector<index_t> riser;               ///< confluence → hanging point
   index_t confluence = -1, hanging_point = -1;
   std::vector<std::array<index_t, 2>> line_segments, riser_segments;
   std::vector<double> line_rest_length, riser_rest_length;  ///< per segment (m)
@@ -111,8 +111,8 @@ inline suspension_mesh suspension_lines(std::vector<Eigen::Vector3d>& positions,
   require(!attachments.empty(), "model::suspension_lines: no attachment nodes");
   double zc = 0;
   for (const index_t a : attachments) {
-    require(a >= 0 && a < index_t(positions.size()), "model::suspension_lines: attachment node ", a,
-            " outside [0, ", positions.size(), ")");
+    require(a >= 0 && a < index_t(positions.size()), "model::suspension_lines: attachment node ", a, " outside [0, ",
+            positions.size(), ")");
     const Eigen::Vector3d& x = positions[std::size_t(a)];
     const double rho = x.head<2>().norm();
     require(rho < p.line_length, "model::suspension_lines: line length Ls = ", p.line_length,

@@ -80,35 +80,35 @@ namespace parafsi::scene {
 /// Every choice of a drop run. The defaults are parachute_drop's (its flags bind to these
 /// fields); `out` empty writes no files.
 struct drop_config {
-  std::string canopy = "paper";      ///< paper | c9
-  std::string fabric = "mat544";     ///< paper canopy: mat544 | mat59225 | mat509
-  std::string resolution = "coarse"; ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
-  std::string coupling = "embedded"; ///< embedded | penalty
-  std::string viscosity = "auto";    ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
-  double t_end = 6.0;                ///< simulated time (s)
-  double history_every = 0.005;      ///< output interval (s)
+  std::string canopy = "paper";       ///< paper | c9
+  std::string fabric = "mat544";      ///< paper canopy: mat544 | mat59225 | mat509
+  std::string resolution = "coarse";  ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
+  std::string coupling = "embedded";  ///< embedded | penalty
+  std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
+  double t_end = 6.0;                 ///< simulated time (s)
+  double history_every = 0.005;       ///< output interval (s)
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
-  double growth = 0;                 ///< cell growth factor outside the refined block; 0 = the resolution's
-  double cfl = 0.9;                  ///< CFL number of the fluid step
+  double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
+  double cfl = 0.9;   ///< CFL number of the fluid step
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
-  double membrane_damping = 0.05;    ///< membrane damping ratio of its highest mode
-  double impedance = 1.0;            ///< embedded: impedance (added-mass) stabilisation factor ζ
-  double pgs_alpha = 0.0;            ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
-  double cell = 0, element = 0;      ///< overrides of the resolution (/ D0), 0 = the resolution's
-  double initial_speed = -1;         ///< override of the scene's release speed (m/s), < 0 = scene
-  double payload_mass = -1;          ///< override of the payload mass (kg), <= 0 = scene
-  double line_stiffness = 1;         ///< multiplies EA of lines, riser and tapes (sensitivity, extremes)
-  double modulus_scale = 1;          ///< multiplies the fabric moduli E11, E22, G12
-  std::string packed = "scene";      ///< scene | reduced_radius | star_fold | constructed
-  double packed_parameter = -1;      ///< reduced_radius: s; star_fold: seam half-angle (deg); < 0 = default
-  std::string box = "follow";        ///< follow: the paper's moving box; fixed: a fixed box holding the fall
-  double fixed_fall = 0;             ///< fixed box: fall length (m) the refined column extends below the start
+  double membrane_damping = 0.05;                                ///< membrane damping ratio of its highest mode
+  double impedance = 1.0;        ///< embedded: impedance (added-mass) stabilisation factor ζ
+  double pgs_alpha = 0.0;        ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
+  double cell = 0, element = 0;  ///< overrides of the resolution (/ D0), 0 = the resolution's
+  double initial_speed = -1;     ///< override of the scene's release speed (m/s), < 0 = scene
+  double payload_mass = -1;      ///< override of the payload mass (kg), <= 0 = scene
+  double line_stiffness = 1;     ///< multiplies EA of lines, riser and tapes (sensitivity, extremes)
+  double modulus_scale = 1;      ///< multiplies the fabric moduli E11, E22, G12
+  std::string packed = "scene";  ///< scene | reduced_radius | star_fold | constructed
+  double packed_parameter = -1;  ///< reduced_radius: s; star_fold: seam half-angle (deg); < 0 = default
+  std::string box = "follow";    ///< follow: the paper's moving box; fixed: a fixed box holding the fall
+  double fixed_fall = 0;         ///< fixed box: fall length (m) the refined column extends below the start
   std::vector<double> slice_times{0.1, 0.2, 0.3, 0.5, 1, 2, 4, 6};  ///< mid-plane slice times (s)
-  std::string out = "out/drop";      ///< output directory; empty: no files
-  double vtk_every = 0;              ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
-  double checkpoint_every = 0;       ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
-  std::string restart;               ///< checkpoint to continue from (same scene and flags)
-  bool quiet = false;                ///< no messages on stderr
+  std::string out = "out/drop";                                     ///< output directory; empty: no files
+  double vtk_every = 0;         ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
+  double checkpoint_every = 0;  ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
+  std::string restart;          ///< checkpoint to continue from (same scene and flags)
+  bool quiet = false;           ///< no messages on stderr
 
   /// Throws invalid_input naming a bad field (non-finite numbers included).
   void validate() const {
@@ -125,14 +125,29 @@ struct drop_config {
     require(one_of(packed, {"scene", "reduced_radius", "star_fold", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
-    const std::pair<const char*, double> numbers[] = {
-        {"t_end", t_end}, {"history_every", history_every}, {"box_width", box_width}, {"box_length", box_length},
-        {"box_ahead", box_ahead}, {"growth", growth}, {"cfl", cfl}, {"pfac", pfac}, {"stiffening", stiffening},
-        {"coupling_damping", coupling_damping}, {"membrane_damping", membrane_damping}, {"impedance", impedance},
-        {"pgs_alpha", pgs_alpha}, {"cell", cell}, {"element", element}, {"initial_speed", initial_speed},
-        {"payload_mass", payload_mass}, {"line_stiffness", line_stiffness}, {"modulus_scale", modulus_scale},
-        {"packed_parameter", packed_parameter}, {"fixed_fall", fixed_fall}, {"vtk_every", vtk_every},
-        {"checkpoint_every", checkpoint_every}};
+    const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
+                                                      {"history_every", history_every},
+                                                      {"box_width", box_width},
+                                                      {"box_length", box_length},
+                                                      {"box_ahead", box_ahead},
+                                                      {"growth", growth},
+                                                      {"cfl", cfl},
+                                                      {"pfac", pfac},
+                                                      {"stiffening", stiffening},
+                                                      {"coupling_damping", coupling_damping},
+                                                      {"membrane_damping", membrane_damping},
+                                                      {"impedance", impedance},
+                                                      {"pgs_alpha", pgs_alpha},
+                                                      {"cell", cell},
+                                                      {"element", element},
+                                                      {"initial_speed", initial_speed},
+                                                      {"payload_mass", payload_mass},
+                                                      {"line_stiffness", line_stiffness},
+                                                      {"modulus_scale", modulus_scale},
+                                                      {"packed_parameter", packed_parameter},
+                                                      {"fixed_fall", fixed_fall},
+                                                      {"vtk_every", vtk_every},
+                                                      {"checkpoint_every", checkpoint_every}};
     for (const auto& [name, v] : numbers)
       require(std::isfinite(v), "parachute_drop: ", name, " must be a finite number, got ", v);
     for (double t : slice_times)
@@ -142,22 +157,28 @@ struct drop_config {
     require(t_end / history_every <= 1e9, "parachute_drop: t_end / history_every = ", t_end / history_every,
             " output instants, more than 1e9");
     require(cfl > 0 && cfl <= 1, "parachute_drop: cfl must be in (0, 1], got ", cfl);
-    require(growth == 0 || (growth >= 1 && growth <= 2), "parachute_drop: growth must be in [1, 2] (0: the "
-            "resolution's), got ", growth);
-    require(cell >= 0 && element >= 0, "parachute_drop: cell and element sizes must be >= 0 (0: the resolution's), "
-            "got ", cell, " and ", element);
+    require(growth == 0 || (growth >= 1 && growth <= 2),
+            "parachute_drop: growth must be in [1, 2] (0: the "
+            "resolution's), got ",
+            growth);
+    require(cell >= 0 && element >= 0,
+            "parachute_drop: cell and element sizes must be >= 0 (0: the resolution's), "
+            "got ",
+            cell, " and ", element);
     // Penalty stiffening multiplies the springs by 1 + (d/(λh))², which the stable step does
     // not see: a tiny λ diverges.
     require(stiffening == 0 || (stiffening >= 0.01 && stiffening <= 10),
             "parachute_drop: --stiffening must be 0 (off) or in [0.01, 10], got ", stiffening);
     require(line_stiffness > 0, "parachute_drop: line stiffness scale must be > 0, got ", line_stiffness);
     require(modulus_scale > 0, "parachute_drop: fabric modulus scale must be > 0, got ", modulus_scale);
-    require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: --pgs (PGS alpha) must be >= 1 (0: auto), got ", pgs_alpha);
-    require(vtk_every >= 0 && checkpoint_every >= 0, "parachute_drop: VTK and checkpoint intervals must be >= 0 s, "
-            "got ", vtk_every, " and ", checkpoint_every);
-    require(!out.empty() || (vtk_every == 0 && checkpoint_every == 0),
-            "parachute_drop: --vtk-every ", vtk_every, " and --checkpoint-every ", checkpoint_every,
-            " need an output directory, but --out is empty (no files)");
+    require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: --pgs (PGS alpha) must be >= 1 (0: auto), got ",
+            pgs_alpha);
+    require(vtk_every >= 0 && checkpoint_every >= 0,
+            "parachute_drop: VTK and checkpoint intervals must be >= 0 s, "
+            "got ",
+            vtk_every, " and ", checkpoint_every);
+    require(!out.empty() || (vtk_every == 0 && checkpoint_every == 0), "parachute_drop: --vtk-every ", vtk_every,
+            " and --checkpoint-every ", checkpoint_every, " need an output directory, but --out is empty (no files)");
     require(packed != "reduced_radius" || packed_parameter < 0 || (packed_parameter > 0 && packed_parameter <= 1),
             "parachute_drop: --packed-parameter ", packed_parameter,
             ": the reduced radius s of the packed canopy must be in (0, 1] (negative: the default 0.2)");
@@ -191,9 +212,9 @@ struct drop_setup {
   model::drop_resolution resolution;    ///< the preset after the overrides
   model::drop_scene scene;
   model::drop_box box;
-  double alpha = 1;                     ///< pressure-gradient scaling α (auto resolved)
-  bool fixed_box = false;               ///< frame::fixed instead of frame::follow_payload
-  bool viscous = false;                 ///< constant μ instead of inviscid
+  double alpha = 1;        ///< pressure-gradient scaling α (auto resolved)
+  bool fixed_box = false;  ///< frame::fixed instead of frame::follow_payload
+  bool viscous = false;    ///< constant μ instead of inviscid
 };
 
 /// The scene, box and numbers of the config `c` (validated first).
@@ -217,8 +238,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   else if (c.packed == "star_fold")
     P.shape = model::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi /
                                              180.0);
-  else if (c.packed == "constructed")
-    P.shape = model::packed_shape::constructed();
+  else if (c.packed == "constructed") P.shape = model::packed_shape::constructed();
   su.fixed_box = c.box == "fixed";
   P.canopy.element_size = R.element * D0;
   // The model's refusals name counts and sizes; the flags that set them are added here.
@@ -310,8 +330,8 @@ class drop_run {
                    "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%ldx%ldx%ld, h = %.4g m near the canopy), "
                    "%ld structure nodes, %zu triangles, coupling %s, %s box, PGS alpha %g, t_end %.3g s\n",
                    su_.params.name.c_str(), res.fabric.c_str(), c_.resolution.c_str(), res.cells, long(g.n(0)),
-                   long(g.n(1)), long(g.n(2)), su_.box.cell, res.nodes, su_.scene.triangles.size(),
-                   c_.coupling.c_str(), c_.box.c_str(), su_.alpha, c_.t_end);
+                   long(g.n(1)), long(g.n(2)), su_.box.cell, res.nodes, su_.scene.triangles.size(), c_.coupling.c_str(),
+                   c_.box.c_str(), su_.alpha, c_.t_end);
     if (c_.restart.empty()) record(res.history);
     write_outputs();
     const auto t0 = std::chrono::steady_clock::now();
@@ -376,9 +396,9 @@ class drop_run {
             "): restart with the --pgs and scene of the run that wrote it");
     require(c_.t_end > s_.time() + 1e-12, "parachute_drop: t_end ", c_.t_end,
             " s is not after the time of checkpoint '", c_.restart, "', ", s_.time(), " s: nothing to run");
-    require(!previous.rows.empty() && previous.rows.back().t <= s_.time() + 1e-12,
-            "parachute_drop: checkpoint '", c_.restart, "' holds ", previous.rows.size(),
-            " history rows, the last not at or before its time ", s_.time(), " s");
+    require(!previous.rows.empty() && previous.rows.back().t <= s_.time() + 1e-12, "parachute_drop: checkpoint '",
+            c_.restart, "' holds ", previous.rows.size(), " history rows, the last not at or before its time ",
+            s_.time(), " s");
     if (!c_.quiet)
       std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows carried)\n",
                    c_.restart.c_str(), s_.time(), previous.rows.size());
@@ -442,9 +462,8 @@ class drop_run {
   double next_step(double target) {
     const double dt = s_.stable_dt(c_.cfl);
     if (!(dt > 1e-9 * c_.history_every) || !std::isfinite(dt))
-      throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt,
-                                                      " s at t = ", s_.time(), " s (coupling ", c_.coupling,
-                                                      "); stopping"),
+      throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt, " s at t = ",
+                                                      s_.time(), " s (coupling ", c_.coupling, "); stopping"),
                               -1, s_.time());
     return landing_step(dt, target - s_.time());
   }
@@ -458,8 +477,8 @@ class drop_run {
     const double fall = su_.box.fall;
     if (xi.z() < -fall)
       throw numerical_failure(parafsi::detail::concat("parachute_drop: the payload has fallen ", -xi.z(),
-                                                      " m, beyond the fixed box's fall length ", fall, " m, at t = ",
-                                                      s_.time(), " s; raise --fixed-fall"),
+                                                      " m, beyond the fixed box's fall length ", fall,
+                                                      " m, at t = ", s_.time(), " s; raise --fixed-fall"),
                               -1, s_.time());
   }
 

@@ -39,8 +39,7 @@ void place_drop_box(Fluid& f, const model::drop_box& b, const structure::drop_as
   f.pose().R.col(1) = b.axes.col(1);
   f.pose().R.col(2) = b.axes.col(2);
   f.pose().X = body.mass_centre();
-  if constexpr (requires(const Eigen::Vector3d& x) { f.frame().track(x, x); })
-    f.pose().V = body.mass_centre_velocity();
+  if constexpr (requires(const Eigen::Vector3d& x) { f.frame().track(x, x); }) f.pose().V = body.mass_centre_velocity();
 }
 
 /// The payload's rigid body of a drop assembly (the body a following box tracks).
@@ -58,10 +57,9 @@ struct drop_payload_body {
 /// a fixed box gets none.
 template <class Fluid>
 auto drop_frame_target(double gravity) {
-  if constexpr (requires(Fluid& f, const Eigen::Vector3d& x) { f.frame().track(x, x); })
+  if constexpr (requires(Fluid & f, const Eigen::Vector3d& x) { f.frame().track(x, x); })
     return follow_body<drop_payload_body>{drop_payload_body{}, gravity};
-  else
-    return no_frame_target{};
+  else return no_frame_target{};
 }
 template <class Fluid>
 using drop_frame_target_t = decltype(drop_frame_target<Fluid>(0.0));

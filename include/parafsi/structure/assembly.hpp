@@ -42,18 +42,30 @@
 namespace parafsi::structure {
 
 template <class P>
-concept body_part = requires { P::is_body; } && P::is_body;
+concept body_part = requires {
+  P::is_body;
+}
+&&P::is_body;
 template <class P>
-concept line_part = requires(const P& p, std::vector<double>& k) { p.add_node_stiffness(k); };
+concept line_part = requires(const P& p, std::vector<double>& k) {
+  p.add_node_stiffness(k);
+};
 
 /// Adds coupling / user loads to nodes; when energy is tracked they count as external work.
 class load_sink {
  public:
   load_sink(nodes& nd, bool track) : s_(nd.data()), track_(track) {}
   void add(index_t i, const Eigen::Vector3d& f) {
-    s_.get<field::fx>()[i] += f.x(); s_.get<field::fy>()[i] += f.y(); s_.get<field::fz>()[i] += f.z();
-    if (track_) { s_.get<field::fex>()[i] += f.x(); s_.get<field::fey>()[i] += f.y(); s_.get<field::fez>()[i] += f.z(); }
+    s_.get<field::fx>()[i] += f.x();
+    s_.get<field::fy>()[i] += f.y();
+    s_.get<field::fz>()[i] += f.z();
+    if (track_) {
+      s_.get<field::fex>()[i] += f.x();
+      s_.get<field::fey>()[i] += f.y();
+      s_.get<field::fez>()[i] += f.z();
+    }
   }
+
  private:
   nodes::storage& s_;
   bool track_;
@@ -81,9 +93,13 @@ class assembly {
   nodes& node_set() noexcept { return nodes_; }
   const nodes& node_set() const noexcept { return nodes_; }
   template <std::size_t I>
-  auto& part() noexcept { return std::get<I>(parts_); }
+  auto& part() noexcept {
+    return std::get<I>(parts_);
+  }
   template <std::size_t I>
-  const auto& part() const noexcept { return std::get<I>(parts_); }
+  const auto& part() const noexcept {
+    return std::get<I>(parts_);
+  }
   central_difference& integrator() noexcept { return cd_; }
   double time() const noexcept { return t_; }
   long steps() const noexcept { return steps_; }
@@ -103,21 +119,29 @@ class assembly {
     nodes_.reset_masses();
     std::apply([&](auto&... p) { (p.finalize(nodes_), ...); }, parts_);
     nodes_.finalize_masses();
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (requires { p.post_finalize(nodes_); }) p.post_finalize(nodes_);
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (requires { p.post_finalize(nodes_); }) p.post_finalize(nodes_);
+          }(),
+          ...);
+        },
+        parts_);
     ksum_.assign(std::size_t(nodes_.size()), 0.0);
     double xi = 0;
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (line_part<std::remove_cvref_t<decltype(p)>>) {
-          p.add_node_stiffness(ksum_);
-          xi = std::max(xi, p.damping_ratio());
-        }
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (line_part<std::remove_cvref_t<decltype(p)>>) {
+              p.add_node_stiffness(ksum_);
+              xi = std::max(xi, p.damping_ratio());
+            }
+          }(),
+          ...);
+        },
+        parts_);
     dt_nodal_ = std::numeric_limits<double>::infinity();
     for (index_t i = 0; i < nodes_.size(); ++i)
       if (nodes_.kind(i) == constraint::free && ksum_[std::size_t(i)] > 0)
@@ -131,12 +155,16 @@ class assembly {
   double stable_dt() {
     if (nodes_.needs_finalize()) finalize();
     double dt = dt_nodal_;
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) dt = std::min(dt, p.critical_dt(ksum_));
-        else dt = std::min(dt, p.critical_dt(nodes_));
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) dt = std::min(dt, p.critical_dt(ksum_));
+            else dt = std::min(dt, p.critical_dt(nodes_));
+          }(),
+          ...);
+        },
+        parts_);
     return cd_.tssf * dt;
   }
 
@@ -174,8 +202,11 @@ class assembly {
   /// ½ Σ m|v|² over free nodes + rigid bodies (velocities at the last half step).
   double kinetic_energy() const {
     const auto& s = nodes_.data();
-    const double* vx = s.get<field::vx>(); const double* vy = s.get<field::vy>(); const double* vz = s.get<field::vz>();
-    const double* m = s.get<field::m>(); const double* mi = s.get<field::minv>();
+    const double* vx = s.get<field::vx>();
+    const double* vy = s.get<field::vy>();
+    const double* vz = s.get<field::vz>();
+    const double* m = s.get<field::m>();
+    const double* mi = s.get<field::minv>();
     double k = 0;
     for (index_t i = 0; i < nodes_.size(); ++i)
       if (mi[i] > 0) k += 0.5 * m[i] * (vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]);
@@ -201,11 +232,15 @@ class assembly {
 
   template <class F>
   void for_each_body(F&& f) const {
-    std::apply([&](const auto&... p) {
-      ((void)[&] {
-        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) f(p);
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](const auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) f(p);
+          }(),
+          ...);
+        },
+        parts_);
   }
 
   // ------------------------------------------------------------------ checkpoint
@@ -217,8 +252,8 @@ class assembly {
   /// restored through their own accessors.
   void restore_clock(double t, long steps, double previous_step, bool track, const energy_ledger& ledger) {
     require(std::isfinite(t) && steps >= 0 && std::isfinite(previous_step) && previous_step >= 0,
-            "assembly::restore_clock: need finite t, steps >= 0 and previous step >= 0, got t = ", t, ", steps = ",
-            steps, ", previous step = ", previous_step);
+            "assembly::restore_clock: need finite t, steps >= 0 and previous step >= 0, got t = ", t,
+            ", steps = ", steps, ", previous step = ", previous_step);
     t_ = t;
     steps_ = steps;
     dt_prev_ = previous_step;
@@ -251,7 +286,8 @@ class assembly {
     auto each_part = [&](auto&& f) {
       [&]<std::size_t... I>(std::index_sequence<I...>) {
         (f(std::string("part") + std::to_string(I), std::get<I>(self.parts_)), ...);
-      }(std::make_index_sequence<part_count>{});
+      }
+      (std::make_index_sequence<part_count>{});
     };
     const index_t N = self.nodes_.size();
     ar.check("type", name(), "the assembly type");
@@ -270,12 +306,12 @@ class assembly {
       if constexpr (requires { p.element(index_t(0)); })
         ar.check_digest(k + ".reference", k + " (" + p.name() + "): connectivity, rest lengths or reference areas",
                         [&](auto put) {
-                          for (index_t e = 0; e < p.size(); ++e) {
-                            for (auto n : p.element(e)) put(n);
-                            if constexpr (requires { p.rest_length(e); }) put(p.rest_length(e));
-                            if constexpr (requires { p.reference_area(e); }) put(p.reference_area(e));
-                          }
-                        });
+          for (index_t e = 0; e < p.size(); ++e) {
+            for (auto n : p.element(e)) put(n);
+            if constexpr (requires { p.rest_length(e); }) put(p.rest_length(e));
+            if constexpr (requires { p.reference_area(e); }) put(p.reference_area(e));
+          }
+        });
     });
     ar.fields("node", self.nodes_.data());
     each_part([&](const std::string& k, auto& p) {
@@ -302,11 +338,15 @@ class assembly {
   template <bool Track, class Loads>
   double compute_phase(Loads& loads) {
     // Phase 1. Attached nodes from the body poses.
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) p.place_nodes(nodes_);
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) p.place_nodes(nodes_);
+          }(),
+          ...);
+        },
+        parts_);
     // Phase 2. Body loads and external loads.
     cd_.template clear_forces<Track>(nodes_);
     {
@@ -316,15 +356,19 @@ class assembly {
     // Phase 3. Element forces (membranes, cables, tapes), then race-free scatter.
     const node_kinematics kin = nodes_.kinematics();
     double strain = 0;  // filled when Track
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
-          p.template compute_forces<Track>(kin);
-          p.template scatter<Track>(nodes_);
-          if constexpr (Track) strain += p.strain_energy();
-        }
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
+              p.template compute_forces<Track>(kin);
+              p.template scatter<Track>(nodes_);
+              if constexpr (Track) strain += p.strain_energy();
+            }
+          }(),
+          ...);
+        },
+        parts_);
     return strain;
   }
 
@@ -334,11 +378,16 @@ class assembly {
     const double strain = compute_phase<Track>(loads);
     // Phase 4. Rigid bodies.
     double w_body = 0;
-    std::apply([&](auto&... p) {
-      ((void)[&] {
-        if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) w_body += p.step(nodes_, cd_.gravity, dt_kick, dt);
-      }(), ...);
-    }, parts_);
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>)
+              w_body += p.step(nodes_, cd_.gravity, dt_kick, dt);
+          }(),
+          ...);
+        },
+        parts_);
     // Phase 5. Central-difference update of the nodes.
     const auto r = cd_.template update<Track>(nodes_, dt_kick, dt);
     if (r.bad_node >= 0) fail(r.bad_node);
@@ -357,17 +406,21 @@ class assembly {
 
   [[noreturn]] void fail(index_t node) {
     std::string where;
-    std::apply([&](const auto&... p) {
-      ((void)[&] {
-        if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
-          const index_t e = p.first_bad_element();
-          if (e >= 0 && where.empty()) where = parafsi::detail::concat(" (first non-finite force: ", p.name(), " element ", e, ")");
-        }
-      }(), ...);
-    }, parts_);
-    throw numerical_failure(parafsi::detail::concat("structure::assembly: node ", node, " became non-finite at t = ", t_,
-                                           where, "; the step may exceed stable_dt() = ",
-                                           stable_dt()),
+    std::apply(
+        [&](const auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (!body_part<std::remove_cvref_t<decltype(p)>>) {
+              const index_t e = p.first_bad_element();
+              if (e >= 0 && where.empty())
+                where = parafsi::detail::concat(" (first non-finite force: ", p.name(), " element ", e, ")");
+            }
+          }(),
+          ...);
+        },
+        parts_);
+    throw numerical_failure(parafsi::detail::concat("structure::assembly: node ", node, " became non-finite at t = ",
+                                                    t_, where, "; the step may exceed stable_dt() = ", stable_dt()),
                             node, t_);
   }
 

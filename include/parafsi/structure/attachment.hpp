@@ -43,8 +43,7 @@ class attachment {
   /// Tie node `node` to the body point r_body (from the body origin, body axes).
   void attach(index_t node, const Eigen::Vector3d& r_body) {
     require(r_body.allFinite(), "attachment::attach: non-finite body offset for node ", node);
-    for (const auto& a : points_)
-      require(a.node != node, "attachment::attach: node ", node, " is already attached");
+    for (const auto& a : points_) require(a.node != node, "attachment::attach: node ", node, " is already attached");
     points_.push_back({node, r_body});
   }
   Body& body() noexcept { return body_; }
@@ -75,8 +74,12 @@ class attachment {
     auto& s = nd.data();
     for (const auto& a : points_) {
       const Eigen::Vector3d x = body_.point_position(a.r), v = body_.point_velocity(a.r);
-      s.get<field::x>()[a.node] = x.x(); s.get<field::y>()[a.node] = x.y(); s.get<field::z>()[a.node] = x.z();
-      s.get<field::vx>()[a.node] = v.x(); s.get<field::vy>()[a.node] = v.y(); s.get<field::vz>()[a.node] = v.z();
+      s.get<field::x>()[a.node] = x.x();
+      s.get<field::y>()[a.node] = x.y();
+      s.get<field::z>()[a.node] = x.z();
+      s.get<field::vx>()[a.node] = v.x();
+      s.get<field::vy>()[a.node] = v.y();
+      s.get<field::vz>()[a.node] = v.z();
     }
   }
 

@@ -68,7 +68,8 @@ class cable {
     if (mesh_.rest_length.empty()) {
       for (index_t e = 0; e < n_; ++e) {
         const auto& s = mesh_.segments[std::size_t(e)];
-        require(s[0] >= 0 && s[0] < N && s[1] >= 0 && s[1] < N, "cable: element ", e, " names a node outside [0, ", N, ")");
+        require(s[0] >= 0 && s[0] < N && s[1] >= 0 && s[1] < N, "cable: element ", e, " names a node outside [0, ", N,
+                ")");
         mesh_.rest_length.push_back((nd.position(s[1]) - nd.position(s[0])).norm());
       }
     }
@@ -121,7 +122,9 @@ class cable {
     });
   }
   template <bool Track>
-  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
+  void scatter(nodes& nd) const {
+    out_.template scatter<Track>(nd);
+  }
   double strain_energy() const { return out_.strain_energy(); }
 
   index_t first_bad_element() const { return out_.first_bad_element(); }
@@ -141,7 +144,8 @@ class cable {
  private:
   template <class V, bool Track>
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e) {
-    const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e;
+    const index_t* i0 = conn_[0].data() + e;
+    const index_t* i1 = conn_[1].data() + e;
     const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1);
     const vec3<V> v0 = impl::gather_velocity<V>(k, i0), v1 = impl::gather_velocity<V>(k, i1);
     const V L0 = simd::load<V>(L0_.data() + e), kk = simd::load<V>(k_.data() + e), cd = simd::load<V>(cd_.data() + e);

@@ -53,20 +53,33 @@ struct central_difference {
   template <bool Track>
   void clear_forces(nodes& nd) const {
     auto& s = nd.data();
-    double* fx = s.get<field::fx>(); double* fy = s.get<field::fy>(); double* fz = s.get<field::fz>();
-    const double* m = s.get<field::m>(); const double* mi = s.get<field::minv>();
-    double* fdx = s.get<field::fdx>(); double* fdy = s.get<field::fdy>(); double* fdz = s.get<field::fdz>();
-    double* fex = s.get<field::fex>(); double* fey = s.get<field::fey>(); double* fez = s.get<field::fez>();
+    double* fx = s.get<field::fx>();
+    double* fy = s.get<field::fy>();
+    double* fz = s.get<field::fz>();
+    const double* m = s.get<field::m>();
+    const double* mi = s.get<field::minv>();
+    double* fdx = s.get<field::fdx>();
+    double* fdy = s.get<field::fdy>();
+    double* fdz = s.get<field::fdz>();
+    double* fex = s.get<field::fex>();
+    double* fey = s.get<field::fey>();
+    double* fez = s.get<field::fez>();
     const double gx = gravity.x(), gy = gravity.y(), gz = gravity.z();
     impl::for_each_chunk(nd.size(), [&](index_t b, index_t e, index_t) {
       simd::for_each_pack(b, e, [&](auto tag, index_t i) {
         using V = typename decltype(tag)::type;
         const V mg = simd::select(simd::load<V>(mi + i) > V(0.0), simd::load<V>(m + i), V(0.0));
-        simd::store(fx + i, mg * V(gx)); simd::store(fy + i, mg * V(gy)); simd::store(fz + i, mg * V(gz));
+        simd::store(fx + i, mg * V(gx));
+        simd::store(fy + i, mg * V(gy));
+        simd::store(fz + i, mg * V(gz));
         if constexpr (Track) {
           const V z(0.0);
-          simd::store(fdx + i, z); simd::store(fdy + i, z); simd::store(fdz + i, z);
-          simd::store(fex + i, z); simd::store(fey + i, z); simd::store(fez + i, z);
+          simd::store(fdx + i, z);
+          simd::store(fdy + i, z);
+          simd::store(fdz + i, z);
+          simd::store(fex + i, z);
+          simd::store(fey + i, z);
+          simd::store(fez + i, z);
         }
       });
     });
@@ -81,14 +94,27 @@ struct central_difference {
   template <bool Track>
   update_result update(nodes& nd, double dt_kick, double dt) {
     auto& s = nd.data();
-    double* x = s.get<field::x>(); double* y = s.get<field::y>(); double* z = s.get<field::z>();
-    double* vx = s.get<field::vx>(); double* vy = s.get<field::vy>(); double* vz = s.get<field::vz>();
-    const double* fx = s.get<field::fx>(); const double* fy = s.get<field::fy>(); const double* fz = s.get<field::fz>();
-    const double* fdx = s.get<field::fdx>(); const double* fdy = s.get<field::fdy>(); const double* fdz = s.get<field::fdz>();
-    const double* fex = s.get<field::fex>(); const double* fey = s.get<field::fey>(); const double* fez = s.get<field::fez>();
-    const double* m = s.get<field::m>(); const double* mi = s.get<field::minv>();
+    double* x = s.get<field::x>();
+    double* y = s.get<field::y>();
+    double* z = s.get<field::z>();
+    double* vx = s.get<field::vx>();
+    double* vy = s.get<field::vy>();
+    double* vz = s.get<field::vz>();
+    const double* fx = s.get<field::fx>();
+    const double* fy = s.get<field::fy>();
+    const double* fz = s.get<field::fz>();
+    const double* fdx = s.get<field::fdx>();
+    const double* fdy = s.get<field::fdy>();
+    const double* fdz = s.get<field::fdz>();
+    const double* fex = s.get<field::fex>();
+    const double* fey = s.get<field::fey>();
+    const double* fez = s.get<field::fez>();
+    const double* m = s.get<field::m>();
+    const double* mi = s.get<field::minv>();
     const index_t nc = impl::chunk_count(nd.size());
-    part_k_.assign(std::size_t(nc), 0.0); part_d_.assign(std::size_t(nc), 0.0); part_w_.assign(std::size_t(nc), 0.0);
+    part_k_.assign(std::size_t(nc), 0.0);
+    part_d_.assign(std::size_t(nc), 0.0);
+    part_w_.assign(std::size_t(nc), 0.0);
     bad_.assign(std::size_t(nc), 0);
     const double ha = 0.5 * mass_damping * dt_kick;
     const double gx = gravity.x(), gy = gravity.y(), gz = gravity.z();
@@ -105,10 +131,14 @@ struct central_difference {
         const V nx = c1 * ux + c2 * simd::load<V>(fx + i) * minv;
         const V ny = c1 * uy + c2 * simd::load<V>(fy + i) * minv;
         const V nz = c1 * uz + c2 * simd::load<V>(fz + i) * minv;
-        simd::store(vx + i, nx); simd::store(vy + i, ny); simd::store(vz + i, nz);
+        simd::store(vx + i, nx);
+        simd::store(vy + i, ny);
+        simd::store(vz + i, nz);
         const V X = simd::load<V>(x + i) + V(dt) * nx, Y = simd::load<V>(y + i) + V(dt) * ny,
                 Z = simd::load<V>(z + i) + V(dt) * nz;
-        simd::store(x + i, X); simd::store(y + i, Y); simd::store(z + i, Z);
+        simd::store(x + i, X);
+        simd::store(y + i, Y);
+        simd::store(z + i, Z);
         ok = ok && simd::all_finite(X + Y + Z + nx + ny + nz);
         if constexpr (Track) {
           const V mm = simd::select(is_free, simd::load<V>(m + i), V(0.0));
@@ -122,7 +152,9 @@ struct central_difference {
           w += simd::hsum(simd::select(is_free, pw, V(0.0)));
         }
       });
-      part_k_[std::size_t(c)] = k; part_d_[std::size_t(c)] = d * dt_kick; part_w_[std::size_t(c)] = w * dt_kick;
+      part_k_[std::size_t(c)] = k;
+      part_d_[std::size_t(c)] = d * dt_kick;
+      part_w_[std::size_t(c)] = w * dt_kick;
       bad_[std::size_t(c)] = ok ? 0 : 1;
     });
     update_result r;

@@ -38,8 +38,8 @@ inline auto make_drop_assembly(const model::drop_scene& s, double membrane_dampi
     return cable{line_mesh{cs.segments, cs.rest_length},
                  material::cable{cs.material.EA(), cs.material.mass_per_length, cs.material.damping_ratio, 0.0}};
   };
-  attachment body{rigid_body{rigid_body::cuboid(s.payload.mass, s.payload.size), s.payload.position,
-                             s.payload.attitude, s.payload.velocity}};
+  attachment body{rigid_body{rigid_body::cuboid(s.payload.mass, s.payload.size), s.payload.position, s.payload.attitude,
+                             s.payload.velocity}};
   for (const auto& a : s.attachments) body.attach(a.node, a.r_body);
   assembly chute{std::move(nd),
                  std::move(membrane),
@@ -70,24 +70,38 @@ concept drop_assembly_ref = std::same_as<std::remove_const_t<A>, drop_assembly>;
 
 /// The canopy membrane (`membrane_tri`).
 template <detail::drop_assembly_ref A>
-auto& canopy(A& a) noexcept { return a.template part<drop_part::canopy>(); }
+auto& canopy(A& a) noexcept {
+  return a.template part<drop_part::canopy>();
+}
 /// The suspension lines (`cable`; one segment chain per line, confluence to skirt).
 template <detail::drop_assembly_ref A>
-auto& suspension_lines(A& a) noexcept { return a.template part<drop_part::suspension_lines>(); }
+auto& suspension_lines(A& a) noexcept {
+  return a.template part<drop_part::suspension_lines>();
+}
 /// The riser (`cable`; its last segment ends at the payload).
 template <detail::drop_assembly_ref A>
-auto& riser(A& a) noexcept { return a.template part<drop_part::riser>(); }
+auto& riser(A& a) noexcept {
+  return a.template part<drop_part::riser>();
+}
 /// The skirt tape (`cable`).
 template <detail::drop_assembly_ref A>
-auto& skirt_tape(A& a) noexcept { return a.template part<drop_part::skirt_tape>(); }
+auto& skirt_tape(A& a) noexcept {
+  return a.template part<drop_part::skirt_tape>();
+}
 /// The vent tape (`cable`).
 template <detail::drop_assembly_ref A>
-auto& vent_tape(A& a) noexcept { return a.template part<drop_part::vent_tape>(); }
+auto& vent_tape(A& a) noexcept {
+  return a.template part<drop_part::vent_tape>();
+}
 /// The radial bands (`cable`).
 template <detail::drop_assembly_ref A>
-auto& radial_bands(A& a) noexcept { return a.template part<drop_part::radial_bands>(); }
+auto& radial_bands(A& a) noexcept {
+  return a.template part<drop_part::radial_bands>();
+}
 /// The payload (`attachment`); `payload(a).body()` is its rigid body.
 template <detail::drop_assembly_ref A>
-auto& payload(A& a) noexcept { return a.template part<drop_part::payload>(); }
+auto& payload(A& a) noexcept {
+  return a.template part<drop_part::payload>();
+}
 
 }  // namespace parafsi::structure

@@ -106,10 +106,10 @@ struct quad_mesh {
 };
 
 struct quad_options {
-  double damping_ratio = 0.0;         ///< ζ: damping ratio in the highest mode (β = ζ Δt_e,min)
-  double min_quality = 0.05;          ///< smallest allowed corner sine (reference, about N)
-  double hourglass_stiffness = 0.05;  ///< r_hg (Flanagan–Belytschko stiffness form)
-  double hourglass_viscosity = 0.0;   ///< r_v (Flanagan–Belytschko viscous form)
+  double damping_ratio = 0.0;           ///< ζ: damping ratio in the highest mode (β = ζ Δt_e,min)
+  double min_quality = 0.05;            ///< smallest allowed corner sine (reference, about N)
+  double hourglass_stiffness = 0.05;    ///< r_hg (Flanagan–Belytschko stiffness form)
+  double hourglass_viscosity = 0.0;     ///< r_v (Flanagan–Belytschko viscous form)
   double hourglass_out_of_plane = 1.0;  ///< r_w: scales the w-mode strain (1 = fully integrated)
 };
 
@@ -194,7 +194,8 @@ class membrane_quad {
       const Eigen::Vector3d Xc = 0.25 * (X[0] + X[1] + X[2] + X[3]);
       double xh[4], yh[4], zh[4];
       // Warp normal to the element: fall back to edge 0→1 projected on it.
-      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(name(), mesh_, e), (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn);
+      const auto [E1, E2] = impl::fibre_axes(Nn, impl::warp_of(name(), mesh_, e),
+                                             (X[1] - X[0]) - (X[1] - X[0]).dot(Nn) * Nn);
       for (int a = 0; a < 4; ++a) {
         xh[a] = (X[std::size_t(a)] - Xc).dot(E1);
         yh[a] = (X[std::size_t(a)] - Xc).dot(E2);
@@ -208,7 +209,10 @@ class membrane_quad {
         const double ax = xh[nx] - xh[a], ay = yh[nx] - yh[a], bx = xh[pv] - xh[a], by = yh[pv] - yh[a];
         const double la = std::hypot(ax, ay), lb = std::hypot(bx, by);
         const double s = (la > 0 && lb > 0) ? (ax * by - ay * bx) / (la * lb) : 0.0;
-        if (s < qmin) { qmin = s; worst = a; }
+        if (s < qmin) {
+          qmin = s;
+          worst = a;
+        }
       }
       require(qmin >= opt_.min_quality, "membrane_quad: element ", e, " (nodes ", qd[0], ",", qd[1], ",", qd[2], ",",
               qd[3], ") is degenerate or inverted: corner ", worst, " has sine ", qmin, " < min_quality ",
@@ -221,8 +225,11 @@ class membrane_quad {
       const double h[4] = {1, -1, 1, -1};
       double hx = 0, hy = 0, sbb = 0, sbc = 0, scc = 0;
       for (int a = 0; a < 4; ++a) {
-        hx += h[a] * xh[a]; hy += h[a] * yh[a];
-        sbb += b[a] * b[a]; sbc += b[a] * c[a]; scc += c[a] * c[a];
+        hx += h[a] * xh[a];
+        hy += h[a] * yh[a];
+        sbb += b[a] * b[a];
+        sbc += b[a] * c[a];
+        scc += c[a] * c[a];
       }
       const double bb = sbb + scc;
       double w0 = 0, gg = 0;
@@ -263,7 +270,9 @@ class membrane_quad {
     else run<Track, false, Vectorize>(k);
   }
   template <bool Track>
-  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
+  void scatter(nodes& nd) const {
+    out_.template scatter<Track>(nd);
+  }
 
   /// Strain energy Σ [A0 t ½ S:E + U_hg] from the last tracked evaluation (J).
   double strain_energy() const { return out_.strain_energy(); }
@@ -278,8 +287,7 @@ class membrane_quad {
       vec3<double> F1, F2;
       strains<double>(k, e, F1, F2, E11, E22, E12);
     });
-    return impl::membrane_step(rate * std::sqrt(1.0 + opt_.hourglass_stiffness), opt_.damping_ratio,
-                               mat_.wave_speed());
+    return impl::membrane_step(rate * std::sqrt(1.0 + opt_.hourglass_stiffness), opt_.damping_ratio, mat_.wave_speed());
   }
 
   /// First element with a non-finite corner force (-1 if none), for failure reports.
@@ -353,8 +361,10 @@ class membrane_quad {
   /// (elastic + hourglass) and its hourglass part in `hg` when tracking.
   template <class V, bool Track, bool Damped>
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e, V& hg) {
-    const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e;
-    const index_t* i2 = conn_[2].data() + e; const index_t* i3 = conn_[3].data() + e;
+    const index_t* i0 = conn_[0].data() + e;
+    const index_t* i1 = conn_[1].data() + e;
+    const index_t* i2 = conn_[2].data() + e;
+    const index_t* i3 = conn_[3].data() + e;
     const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1);
     const vec3<V> x2 = impl::gather_position<V>(k, i2), x3 = impl::gather_position<V>(k, i3);
     const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e);
@@ -377,7 +387,8 @@ class membrane_quad {
     const V a1 = dot(F1, qh), a2 = dot(F2, qh);       // in-plane (membrane) hourglass, Fᵀq
     const V dn = qn - simd::load<V>(w0_.data() + e);  // out-of-plane (w) hourglass
     const V km = simd::load<V>(khg_.data() + e);
-    const V Gb = simd::load<V>(gbb_.data() + e), Gx = simd::load<V>(gbc_.data() + e), Gc = simd::load<V>(gcc_.data() + e);
+    const V Gb = simd::load<V>(gbb_.data() + e), Gx = simd::load<V>(gbc_.data() + e),
+            Gc = simd::load<V>(gcc_.data() + e);
     // Step 2. Green–Lagrange strain at the centre + mean second-order strain of the w mode.
     const V dn2 = dn * dn;
     const V E11 = V(0.5) * (dot(F1, F1) - V(1.0)) + dn2 * Gb;

@@ -140,7 +140,8 @@ class membrane_tri {
         nd.add_mass(t[std::size_t(a)], rhoA * 0.5 * A2 / 3.0);
       }
       a0t_[std::size_t(e)] = 0.5 * A2 * mat_.thickness;
-      const double lmax = std::sqrt(std::max({(X1 - X0).squaredNorm(), (X2 - X1).squaredNorm(), (X0 - X2).squaredNorm()}));
+      const double lmax = std::sqrt(
+          std::max({(X1 - X0).squaredNorm(), (X2 - X1).squaredNorm(), (X0 - X2).squaredNorm()}));
       lc_min = std::min(lc_min, A2 / lmax);
       lc0_[std::size_t(e)] = A2 / lmax;
     }
@@ -157,7 +158,9 @@ class membrane_tri {
     else run<Track, false, Vectorize>(k);
   }
   template <bool Track>
-  void scatter(nodes& nd) const { out_.template scatter<Track>(nd); }
+  void scatter(nodes& nd) const {
+    out_.template scatter<Track>(nd);
+  }
 
   /// Strain energy Σ A0 t ½ S:E (filtered S) from the last tracked evaluation (J).
   double strain_energy() const { return out_.strain_energy(); }
@@ -203,10 +206,15 @@ class membrane_tri {
   template <class V>
   PARAFSI_INLINE void strains(const node_kinematics& k, index_t e, vec3<V>& F1, vec3<V>& F2, V& E11, V& E22,
                               V& E12) const {
-    const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e; const index_t* i2 = conn_[2].data() + e;
-    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1), x2 = impl::gather_position<V>(k, i2);
-    const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e), b2 = simd::load<V>(ref_[2].data() + e);
-    const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e), c2 = simd::load<V>(ref_[5].data() + e);
+    const index_t* i0 = conn_[0].data() + e;
+    const index_t* i1 = conn_[1].data() + e;
+    const index_t* i2 = conn_[2].data() + e;
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1),
+                  x2 = impl::gather_position<V>(k, i2);
+    const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e),
+            b2 = simd::load<V>(ref_[2].data() + e);
+    const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e),
+            c2 = simd::load<V>(ref_[5].data() + e);
     F1 = x0 * b0 + x1 * b1 + x2 * b2;
     F2 = x0 * c0 + x1 * c1 + x2 * c2;
     E11 = V(0.5) * (dot(F1, F1) - V(1.0));
@@ -218,10 +226,15 @@ class membrane_tri {
   /// strain energy when tracking.
   template <class V, bool Track, bool Damped>
   PARAFSI_INLINE V kernel(const node_kinematics& k, index_t e) {
-    const index_t* i0 = conn_[0].data() + e; const index_t* i1 = conn_[1].data() + e; const index_t* i2 = conn_[2].data() + e;
-    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1), x2 = impl::gather_position<V>(k, i2);
-    const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e), b2 = simd::load<V>(ref_[2].data() + e);
-    const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e), c2 = simd::load<V>(ref_[5].data() + e);
+    const index_t* i0 = conn_[0].data() + e;
+    const index_t* i1 = conn_[1].data() + e;
+    const index_t* i2 = conn_[2].data() + e;
+    const vec3<V> x0 = impl::gather_position<V>(k, i0), x1 = impl::gather_position<V>(k, i1),
+                  x2 = impl::gather_position<V>(k, i2);
+    const V b0 = simd::load<V>(ref_[0].data() + e), b1 = simd::load<V>(ref_[1].data() + e),
+            b2 = simd::load<V>(ref_[2].data() + e);
+    const V c0 = simd::load<V>(ref_[3].data() + e), c1 = simd::load<V>(ref_[4].data() + e),
+            c2 = simd::load<V>(ref_[5].data() + e);
     // Step 1. Deformation gradient and Green–Lagrange strain.
     const vec3<V> F1 = x0 * b0 + x1 * b1 + x2 * b2;
     const vec3<V> F2 = x0 * c0 + x1 * c1 + x2 * c2;

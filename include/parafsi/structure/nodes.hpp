@@ -27,36 +27,74 @@
 namespace parafsi::structure {
 
 namespace field {
-struct x { static constexpr const char* name = "x"; };
-struct y { static constexpr const char* name = "y"; };
-struct z { static constexpr const char* name = "z"; };
-struct vx { static constexpr const char* name = "vx"; };
-struct vy { static constexpr const char* name = "vy"; };
-struct vz { static constexpr const char* name = "vz"; };
-struct fx { static constexpr const char* name = "fx"; };
-struct fy { static constexpr const char* name = "fy"; };
-struct fz { static constexpr const char* name = "fz"; };
-struct m { static constexpr const char* name = "m"; };
-struct minv { static constexpr const char* name = "minv"; };
+struct x {
+  static constexpr const char* name = "x";
+};
+struct y {
+  static constexpr const char* name = "y";
+};
+struct z {
+  static constexpr const char* name = "z";
+};
+struct vx {
+  static constexpr const char* name = "vx";
+};
+struct vy {
+  static constexpr const char* name = "vy";
+};
+struct vz {
+  static constexpr const char* name = "vz";
+};
+struct fx {
+  static constexpr const char* name = "fx";
+};
+struct fy {
+  static constexpr const char* name = "fy";
+};
+struct fz {
+  static constexpr const char* name = "fz";
+};
+struct m {
+  static constexpr const char* name = "m";
+};
+struct minv {
+  static constexpr const char* name = "minv";
+};
 // Energy bookkeeping: damping and applied (external) parts of f, filled only when tracking.
-struct fdx { static constexpr const char* name = "fdx"; };
-struct fdy { static constexpr const char* name = "fdy"; };
-struct fdz { static constexpr const char* name = "fdz"; };
-struct fex { static constexpr const char* name = "fex"; };
-struct fey { static constexpr const char* name = "fey"; };
-struct fez { static constexpr const char* name = "fez"; };
+struct fdx {
+  static constexpr const char* name = "fdx";
+};
+struct fdy {
+  static constexpr const char* name = "fdy";
+};
+struct fdz {
+  static constexpr const char* name = "fdz";
+};
+struct fex {
+  static constexpr const char* name = "fex";
+};
+struct fey {
+  static constexpr const char* name = "fey";
+};
+struct fez {
+  static constexpr const char* name = "fez";
+};
 }  // namespace field
 
-using node_fields = meta::list<field::x, field::y, field::z, field::vx, field::vy, field::vz, field::fx,
-                               field::fy, field::fz, field::m, field::minv, field::fdx, field::fdy,
-                               field::fdz, field::fex, field::fey, field::fez>;
+using node_fields =
+    meta::list<field::x, field::y, field::z, field::vx, field::vy, field::vz, field::fx, field::fy, field::fz, field::m,
+               field::minv, field::fdx, field::fdy, field::fdz, field::fex, field::fey, field::fez>;
 
 enum class constraint : unsigned char { free = 0, pinned = 1, prescribed = 2, attached = 3 };
 
 /// Read-only positions and velocities, the view element kernels take.
 struct node_kinematics {
-  const double* x; const double* y; const double* z;
-  const double* vx; const double* vy; const double* vz;
+  const double* x;
+  const double* y;
+  const double* z;
+  const double* vx;
+  const double* vy;
+  const double* vz;
   index_t n;
 };
 
@@ -67,10 +105,8 @@ class nodes {
   nodes() = default;
 
   /// Append a node at x with velocity v and an optional point mass (kg). Returns its id.
-  index_t add(const Eigen::Vector3d& x, const Eigen::Vector3d& v = Eigen::Vector3d::Zero(),
-              double point_mass = 0.0) {
-    require(x.allFinite() && v.allFinite(), "structure::nodes::add: non-finite position or velocity for node ",
-            size());
+  index_t add(const Eigen::Vector3d& x, const Eigen::Vector3d& v = Eigen::Vector3d::Zero(), double point_mass = 0.0) {
+    require(x.allFinite() && v.allFinite(), "structure::nodes::add: non-finite position or velocity for node ", size());
     require(point_mass >= 0.0, "structure::nodes::add: point mass must be >= 0, got ", point_mass);
     if (!dirty_pos_) sync_back();
     px_.push_back(x);
@@ -137,8 +173,8 @@ class nodes {
     for (index_t i = 0; i < size(); ++i) {
       const bool free = kind_[std::size_t(i)] == constraint::free;
       if (free)
-        require(m[i] > 0.0 && std::isfinite(m[i]), "structure::nodes: free node ", i,
-                " has mass ", m[i], " (attach it to an element, give it a point mass, or pin it)");
+        require(m[i] > 0.0 && std::isfinite(m[i]), "structure::nodes: free node ", i, " has mass ", m[i],
+                " (attach it to an element, give it a point mass, or pin it)");
       mi[i] = free ? 1.0 / m[i] : 0.0;
       if (!free) constrained_.push_back(i);
     }
@@ -160,14 +196,24 @@ class nodes {
   void set_position(index_t i, const Eigen::Vector3d& x) {
     check(i, "set_position");
     require(x.allFinite(), "structure::nodes::set_position: non-finite position for node ", i);
-    if (dirty_pos_) { px_[std::size_t(i)] = x; return; }
-    s_.get<field::x>()[i] = x.x(); s_.get<field::y>()[i] = x.y(); s_.get<field::z>()[i] = x.z();
+    if (dirty_pos_) {
+      px_[std::size_t(i)] = x;
+      return;
+    }
+    s_.get<field::x>()[i] = x.x();
+    s_.get<field::y>()[i] = x.y();
+    s_.get<field::z>()[i] = x.z();
   }
   void set_velocity(index_t i, const Eigen::Vector3d& v) {
     check(i, "set_velocity");
     require(v.allFinite(), "structure::nodes::set_velocity: non-finite velocity for node ", i);
-    if (dirty_pos_) { pv_[std::size_t(i)] = v; return; }
-    s_.get<field::vx>()[i] = v.x(); s_.get<field::vy>()[i] = v.y(); s_.get<field::vz>()[i] = v.z();
+    if (dirty_pos_) {
+      pv_[std::size_t(i)] = v;
+      return;
+    }
+    s_.get<field::vx>()[i] = v.x();
+    s_.get<field::vy>()[i] = v.y();
+    s_.get<field::vz>()[i] = v.z();
   }
 
   /// Move the staging arrays of add() into the SoA (idempotent; done by finalize).
@@ -188,8 +234,13 @@ class nodes {
   void mark_finalized() noexcept { dirty_ = false; }
 
   node_kinematics kinematics() const noexcept {
-    return {s_.get<field::x>(), s_.get<field::y>(), s_.get<field::z>(),
-            s_.get<field::vx>(), s_.get<field::vy>(), s_.get<field::vz>(), size()};
+    return {s_.get<field::x>(),
+            s_.get<field::y>(),
+            s_.get<field::z>(),
+            s_.get<field::vx>(),
+            s_.get<field::vy>(),
+            s_.get<field::vz>(),
+            size()};
   }
   storage& data() noexcept { return s_; }
   const storage& data() const noexcept { return s_; }

@@ -21,11 +21,11 @@
 namespace parafsi::structure {
 
 struct relax_options {
-  double tolerance = 1e-12;  ///< stop when K < tolerance · K_peak
-  double t_min = 0.0;        ///< never stop before this time (s)
-  double t_max = 1e30;       ///< give up after this time (s)
-  double dt_fraction = 1.0;  ///< step = dt_fraction · stable_dt()
-  long report_every = 1000;  ///< observer period in steps
+  double tolerance = 1e-12;        ///< stop when K < tolerance · K_peak
+  double t_min = 0.0;              ///< never stop before this time (s)
+  double t_max = 1e30;             ///< give up after this time (s)
+  double dt_fraction = 1.0;        ///< step = dt_fraction · stable_dt()
+  long report_every = 1000;        ///< observer period in steps
   long max_steps = 1'000'000'000;  ///< step limit (numerical_failure beyond it)
 };
 
@@ -52,15 +52,13 @@ relax_result relax(Assembly& a, const relax_options& o = {}, Progress&& progress
   const double t0 = a.time();
   double dt = o.dt_fraction * a.stable_dt();
   const double dt0 = dt;
-  auto collapsed = [&](double h) {
-    return !(std::isfinite(h) && h > 0 && h >= 1e-6 * dt0);
-  };
+  auto collapsed = [&](double h) { return !(std::isfinite(h) && h > 0 && h >= 1e-6 * dt0); };
   if (collapsed(dt))
     throw numerical_failure(detail::concat("structure::relax: the stable step is ", dt, " s at the start"), -1, t0);
   if (o.t_max < 1e30 && o.t_max / dt > double(o.max_steps))
-    throw numerical_failure(detail::concat("structure::relax: reaching t_max = ", o.t_max, " s at the stable step ",
-                                           dt, " s takes ", o.t_max / dt, " steps, more than max_steps = ",
-                                           o.max_steps, " (a stiffness too high or a mass too small?)"),
+    throw numerical_failure(detail::concat("structure::relax: reaching t_max = ", o.t_max, " s at the stable step ", dt,
+                                           " s takes ", o.t_max / dt, " steps, more than max_steps = ", o.max_steps,
+                                           " (a stiffness too high or a mass too small?)"),
                             -1, t0);
   for (;;) {
     if (r.steps % 100 == 0) {
@@ -80,7 +78,10 @@ relax_result relax(Assembly& a, const relax_options& o = {}, Progress&& progress
     r.peak = std::max(r.peak, r.kinetic);
     const double t = a.time() - t0;
     if (o.report_every > 0 && r.steps % o.report_every == 0) progress(t, r.kinetic, r.peak);
-    if (t >= o.t_min && r.peak > 0 && r.kinetic < o.tolerance * r.peak) { r.converged = true; break; }
+    if (t >= o.t_min && r.peak > 0 && r.kinetic < o.tolerance * r.peak) {
+      r.converged = true;
+      break;
+    }
     if (t >= o.t_max) break;
   }
   r.time = a.time() - t0;

@@ -60,27 +60,27 @@ namespace parafsi::structure {
 
 /// Mass properties of the bare body about its mass centre, principal body axes.
 struct rigid_body_properties {
-  double mass;                        ///< kg, > 0
-  Eigen::Vector3d inertia_diagonal;   ///< principal moments (kg m²), > 0, triangle inequality
+  double mass;                       ///< kg, > 0
+  Eigen::Vector3d inertia_diagonal;  ///< principal moments (kg m²), > 0, triangle inequality
 };
 
 /// Everything a rigid_body holds: set_state(state()) restarts bit for bit.
 struct rigid_body_state {
-  double mass = 0;                                            ///< total mass (kg)
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< about the mass centre, body axes
-  Eigen::Vector3d com_body = Eigen::Vector3d::Zero();         ///< mass centre c from O, body axes
-  Eigen::Vector3d x_com = Eigen::Vector3d::Zero();            ///< mass centre at t^n
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();      ///< attitude at t^n
-  Eigen::Quaterniond q_half = Eigen::Quaterniond::Identity(); ///< attitude at t^{n−½}
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();                ///< linear momentum at t^{n−½}
-  Eigen::Vector3d l = Eigen::Vector3d::Zero();                ///< spin angular momentum at t^{n−½}
-  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();       ///< ω_b at t^{n−½}
-  Eigen::Vector3d force_com = Eigen::Vector3d::Zero();        ///< pending loads: forces at the mass centre
-  Eigen::Vector3d force_points = Eigen::Vector3d::Zero();     ///< forces at body points
-  Eigen::Vector3d moment_origin = Eigen::Vector3d::Zero();    ///< their moments about O + torques
-  double dt_prev = 0;                                         ///< previous step (0: not started)
-  double time = 0;                                            ///< sum of the steps taken (s)
-  long steps = 0;                                             ///< number of steps taken
+  double mass = 0;                                             ///< total mass (kg)
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();           ///< about the mass centre, body axes
+  Eigen::Vector3d com_body = Eigen::Vector3d::Zero();          ///< mass centre c from O, body axes
+  Eigen::Vector3d x_com = Eigen::Vector3d::Zero();             ///< mass centre at t^n
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();       ///< attitude at t^n
+  Eigen::Quaterniond q_half = Eigen::Quaterniond::Identity();  ///< attitude at t^{n−½}
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();                 ///< linear momentum at t^{n−½}
+  Eigen::Vector3d l = Eigen::Vector3d::Zero();                 ///< spin angular momentum at t^{n−½}
+  Eigen::Vector3d omega_body = Eigen::Vector3d::Zero();        ///< ω_b at t^{n−½}
+  Eigen::Vector3d force_com = Eigen::Vector3d::Zero();         ///< pending loads: forces at the mass centre
+  Eigen::Vector3d force_points = Eigen::Vector3d::Zero();      ///< forces at body points
+  Eigen::Vector3d moment_origin = Eigen::Vector3d::Zero();     ///< their moments about O + torques
+  double dt_prev = 0;                                          ///< previous step (0: not started)
+  double time = 0;                                             ///< sum of the steps taken (s)
+  long steps = 0;                                              ///< number of steps taken
 };
 
 class rigid_body {
@@ -100,8 +100,7 @@ class rigid_body {
 
   /// Throws invalid_input unless the properties describe a physical rigid body.
   static void validate(const rigid_body_properties& props) {
-    require(std::isfinite(props.mass) && props.mass > 0, "rigid_body: mass must be positive, got ",
-            props.mass);
+    require(std::isfinite(props.mass) && props.mass > 0, "rigid_body: mass must be positive, got ", props.mass);
     const Eigen::Vector3d& I = props.inertia_diagonal;
     for (int i = 0; i < 3; ++i)
       require(std::isfinite(I[i]) && I[i] > 0, "rigid_body: principal moment of inertia I", axis_name(i),
@@ -118,16 +117,15 @@ class rigid_body {
 
   rigid_body(rigid_body_properties props, Eigen::Vector3d position,
              Eigen::Quaterniond attitude = Eigen::Quaterniond::Identity(),
-             Eigen::Vector3d velocity = Eigen::Vector3d::Zero(),
-             Eigen::Vector3d omega_body = Eigen::Vector3d::Zero()) {
+             Eigen::Vector3d velocity = Eigen::Vector3d::Zero(), Eigen::Vector3d omega_body = Eigen::Vector3d::Zero()) {
     validate(props);
     require(position.allFinite(), "rigid_body: position must be finite, got (", position.transpose(), ")");
     require(attitude.coeffs().allFinite() && attitude.norm() > 0,
             "rigid_body: attitude quaternion must be finite and non-zero, got (w,x,y,z) = (", attitude.w(), ", ",
             attitude.x(), ", ", attitude.y(), ", ", attitude.z(), ")");
     require(velocity.allFinite(), "rigid_body: velocity must be finite, got (", velocity.transpose(), ")");
-    require(omega_body.allFinite(), "rigid_body: body angular velocity must be finite, got (",
-            omega_body.transpose(), ")");
+    require(omega_body.allFinite(), "rigid_body: body angular velocity must be finite, got (", omega_body.transpose(),
+            ")");
     s_.mass = props.mass;
     s_.inertia = props.inertia_diagonal.asDiagonal();
     s_.x_com = position;
@@ -179,9 +177,7 @@ class rigid_body {
   /// Total applied force (inertial).
   Eigen::Vector3d force() const { return s_.force_com + s_.force_points; }
   /// Total applied moment about the composite mass centre (inertial), at the current pose.
-  Eigen::Vector3d moment() const {
-    return s_.moment_origin - (s_.q * s_.com_body).cross(s_.force_points);
-  }
+  Eigen::Vector3d moment() const { return s_.moment_origin - (s_.q * s_.com_body).cross(s_.force_points); }
 
   /// Attach a lumped mass m (e.g. of a node tied to the body) at body point r. The
   /// body's kinematic state (velocity of O, angular velocity) is kept, so the mass
@@ -189,8 +185,7 @@ class rigid_body {
   /// full tensor about the new mass centre) are updated. Meant for set-up.
   void add_attached_mass(double m, const Eigen::Vector3d& r_body) {
     require(std::isfinite(m) && m >= 0, "rigid_body::add_attached_mass: mass must be non-negative, got ", m);
-    require(r_body.allFinite(), "rigid_body::add_attached_mass: offset must be finite, got (",
-            r_body.transpose(), ")");
+    require(r_body.allFinite(), "rigid_body::add_attached_mass: offset must be finite, got (", r_body.transpose(), ")");
     if (m == 0) return;
     const Eigen::Vector3d v_origin = velocity();
     const Eigen::Vector3d omega_w = angular_velocity_world();
@@ -216,8 +211,8 @@ class rigid_body {
     const Eigen::Vector3d F = force();
     const Eigen::Vector3d M = moment();
     if (!F.allFinite() || !M.allFinite())
-      throw numerical_failure(detail::concat("rigid_body::step: non-finite load at t = ", s_.time,
-                                             ": force (", F.transpose(), "), moment (", M.transpose(), ")"),
+      throw numerical_failure(detail::concat("rigid_body::step: non-finite load at t = ", s_.time, ": force (",
+                                             F.transpose(), "), moment (", M.transpose(), ")"),
                               -1, s_.time);
     const double kick = 0.5 * (s_.dt_prev + dt);
 
@@ -244,11 +239,10 @@ class rigid_body {
       if (it >= max_iterations) break;
     }
     if (!(change <= 1e-8 * scale + std::numeric_limits<double>::min()))
-      throw numerical_failure(
-          detail::concat("rigid_body::step: mid-step attitude did not converge at t = ", s_.time,
-                         " (|omega| dt = ", w.norm() * dt, " rad, change ", change,
-                         "); use a step below critical_dt() = ", critical_dt()),
-          -1, s_.time);
+      throw numerical_failure(detail::concat("rigid_body::step: mid-step attitude did not converge at t = ", s_.time,
+                                             " (|omega| dt = ", w.norm() * dt, " rad, change ", change,
+                                             "); use a step below critical_dt() = ", critical_dt()),
+                              -1, s_.time);
     half = exp_map(0.5 * dt * w);
 
     // 4. Attitude update by the exponential map, then renormalise.
@@ -259,11 +253,10 @@ class rigid_body {
     s_.time += dt;
     ++s_.steps;
 
-    if (!s_.x_com.allFinite() || !s_.p.allFinite() || !s_.l.allFinite() || !s_.q.coeffs().allFinite() ||
-        !w.allFinite())
+    if (!s_.x_com.allFinite() || !s_.p.allFinite() || !s_.l.allFinite() || !s_.q.coeffs().allFinite() || !w.allFinite())
       throw numerical_failure(detail::concat("rigid_body::step: state became non-finite at t = ", s_.time,
-                                             ": position (", s_.x_com.transpose(), "), momentum (",
-                                             s_.p.transpose(), "), angular momentum (", s_.l.transpose(), ")"),
+                                             ": position (", s_.x_com.transpose(), "), momentum (", s_.p.transpose(),
+                                             "), angular momentum (", s_.l.transpose(), ")"),
                               -1, s_.time);
   }
 
@@ -295,9 +288,8 @@ class rigid_body {
     S << 0, -rho.z(), rho.y(), rho.z(), 0, -rho.x(), -rho.y(), rho.x(), 0;
     const Eigen::Matrix3d Jinv_w = R * inertia_inv_ * R.transpose();
     const Eigen::Matrix3d Minv = Eigen::Matrix3d::Identity() / s_.mass - S * Jinv_w * S;
-    const double lmax = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Minv, Eigen::EigenvaluesOnly)
-                            .eigenvalues()
-                            .maxCoeff();
+    const double lmax =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Minv, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
     return 1.0 / lmax;
   }
 
@@ -329,8 +321,7 @@ class rigid_body {
     require(s.x_com.allFinite() && s.p.allFinite() && s.l.allFinite() && s.omega_body.allFinite() &&
                 s.q.coeffs().allFinite() && s.q_half.coeffs().allFinite() && s.com_body.allFinite(),
             "rigid_body::set_state: state must be finite");
-    require(std::isfinite(s.dt_prev) && s.dt_prev >= 0, "rigid_body::set_state: dt_prev must be >= 0, got ",
-            s.dt_prev);
+    require(std::isfinite(s.dt_prev) && s.dt_prev >= 0, "rigid_body::set_state: dt_prev must be >= 0, got ", s.dt_prev);
     s_ = s;
     update_inverse();
   }

@@ -22,15 +22,21 @@ using triangle = std::array<index_t, 3>;
 template <class Asm>
 void collect_triangles(const Asm& s, std::vector<triangle>& tris) {
   [&]<std::size_t... I>(std::index_sequence<I...>) {
-    ((void)[&] {
-      const auto& p = s.template part<I>();
-      using P = std::remove_cvref_t<decltype(p)>;
-      if constexpr (requires { P::corners; p.element(index_t(0)); }) {
-        if constexpr (P::corners == 3)
-          for (index_t e = 0; e < p.size(); ++e) tris.push_back(p.element(e));
-      }
-    }(), ...);
-  }(std::make_index_sequence<Asm::part_count>{});
+    (
+        (void)[&] {
+          const auto& p = s.template part<I>();
+          using P = std::remove_cvref_t<decltype(p)>;
+          if constexpr (requires {
+                          P::corners;
+                          p.element(index_t(0));
+                        }) {
+            if constexpr (P::corners == 3)
+              for (index_t e = 0; e < p.size(); ++e) tris.push_back(p.element(e));
+          }
+        }(),
+        ...);
+  }
+  (std::make_index_sequence<Asm::part_count>{});
 }
 
 /// Base of a membrane coupling `Derived` with porosity law `Porosity` and options

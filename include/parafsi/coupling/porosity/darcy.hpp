@@ -21,8 +21,8 @@ struct darcy {
   static constexpr const char* name() noexcept { return "darcy"; }
 
   static darcy from_reference(double v_ref, double dp_ref, double thickness) {
-    require(v_ref > 0 && dp_ref > 0 && thickness > 0, "porosity::darcy::from_reference: need V_ref, dp_ref, t > 0, got ",
-            v_ref, ", ", dp_ref, ", ", thickness);
+    require(v_ref > 0 && dp_ref > 0 && thickness > 0,
+            "porosity::darcy::from_reference: need V_ref, dp_ref, t > 0, got ", v_ref, ", ", dp_ref, ", ", thickness);
     return {dp_ref / (v_ref * thickness), thickness};
   }
 

@@ -17,18 +17,18 @@
 
 namespace parafsi::boundary {
 struct far_field {
-  double rho = 1.18;                  ///< far-field density (kg/m³)
-  vec3<double> u{0.0, 0.0, 0.0};      ///< far-field velocity (m/s, inertial)
-  double p = 101325.0;                ///< far-field pressure (Pa)
+  double rho = 1.18;              ///< far-field density (kg/m³)
+  vec3<double> u{0.0, 0.0, 0.0};  ///< far-field velocity (m/s, inertial)
+  double p = 101325.0;            ///< far-field pressure (Pa)
 
   static constexpr const char* name() noexcept { return "far_field"; }
 
-  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in,
-                            const vec3<double>& n, double wn, const gas::ideal& g, double) const {
+  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in, const vec3<double>& n, double wn,
+                            const gas::ideal& g, double) const {
     const double gm1 = g.gamma - 1.0;
     const double ci = std::sqrt(g.gamma * in.p / in.rho), cinf = std::sqrt(g.gamma * p / rho);
     const double Ui = dot(in.u, n) - wn, Uinf = dot(u, n) - wn;
-    if (Ui >= ci) return in;  // supersonic outflow
+    if (Ui >= ci) return in;                             // supersonic outflow
     if (Uinf <= -cinf && Ui <= -ci) return {rho, u, p};  // supersonic inflow
     const double Rp = Ui + 2.0 * ci / gm1, Rm = Uinf - 2.0 * cinf / gm1;
     const double Ub = 0.5 * (Rp + Rm), cb = 0.25 * gm1 * (Rp - Rm);

@@ -10,8 +10,8 @@ struct inflow {
   vec3<double> u{0.0, 0.0, 0.0};
   double p = 101325.0;
   static constexpr const char* name() noexcept { return "inflow"; }
-  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>&,
-                            const vec3<double>&, double, const gas::ideal&, double) const {
+  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>&, const vec3<double>&, double,
+                            const gas::ideal&, double) const {
     return {rho, u, p};
   }
 };

@@ -9,8 +9,8 @@ struct outflow {
   bool fix_pressure = false;
   double p_exit = 101325.0;
   static constexpr const char* name() noexcept { return "outflow"; }
-  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in,
-                            const vec3<double>&, double, const gas::ideal&, double) const {
+  fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in, const vec3<double>&, double,
+                            const gas::ideal&, double) const {
     fluid::prim<double> g = in;
     if (fix_pressure) g.p = p_exit;
     return g;

@@ -9,8 +9,8 @@
 namespace parafsi::boundary {
 struct slip_wall {
   static constexpr const char* name() noexcept { return "slip_wall"; }
-  fluid::prim<double> ghost(const fluid::prim<double>& mirror, const fluid::prim<double>&,
-                            const vec3<double>& n, double wn, const gas::ideal&, double) const {
+  fluid::prim<double> ghost(const fluid::prim<double>& mirror, const fluid::prim<double>&, const vec3<double>& n,
+                            double wn, const gas::ideal&, double) const {
     fluid::prim<double> g = mirror;
     g.u = axpy_n(mirror.u, -2.0 * (dot(mirror.u, n) - wn), n);
     return g;

@@ -31,7 +31,8 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
     for (int hi = 0; hi < 2; ++hi) {
       const auto& bc = bcs.face[std::size_t(2 * d + hi)];
       const vec3<double> nout = geo.n[std::size_t(d)] * (hi ? 1.0 : -1.0);
-      std::visit([&](const auto& cond) {
+      std::visit(
+          [&](const auto& cond) {
         using C = std::decay_t<decltype(cond)>;
         par_for(threaded, rb.first, rb.second, [&](index_t q) {
           for (index_t pidx = ra.first; pidx < ra.second; ++pidx) {
@@ -60,7 +61,8 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
             }
           }
         });
-      }, bc);
+          },
+          bc);
     }
   }
 }

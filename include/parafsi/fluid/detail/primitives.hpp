@@ -4,8 +4,8 @@
 #pragma once
 #include <algorithm>
 
-#include "../gas.hpp"
 #include "../../core/simd.hpp"
+#include "../gas.hpp"
 #include "stage.hpp"
 
 namespace parafsi::fluid::detail {

@@ -24,8 +24,8 @@ namespace parafsi::fluid::detail {
 /// `mu_t`: eddy viscosity per cell (when Turbulence::active), else unused.
 template <bool Viscous, class Viscosity, class Turbulence>
 double max_wave_rate(const rectilinear_grid& grid, const gas::ideal& gas, const frame::pose& pose,
-                     const fields5<const double>& U, const Viscosity& visc, const Turbulence& turb,
-                     const double* mu_t, double cfl, std::vector<double>& slots, bool threaded) {
+                     const fields5<const double>& U, const Viscosity& visc, const Turbulence& turb, const double* mu_t,
+                     double cfl, std::vector<double>& slots, bool threaded) {
   const Eigen::Matrix3d Rt = pose.R.transpose();
   const Eigen::Vector3d vh = Rt * pose.V, oh = Rt * pose.Omega;
   const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
@@ -63,8 +63,8 @@ double max_wave_rate(const rectilinear_grid& grid, const gas::ideal& gas, const 
   (void)visc;
   (void)turb;
   (void)mu_t;
-  return parallel::reduce(index_t(0), ny * nz, 0.0, row_max, [](double a, double b) { return std::max(a, b); },
-                          threaded, slots);
+  return parallel::reduce(
+      index_t(0), ny * nz, 0.0, row_max, [](double a, double b) { return std::max(a, b); }, threaded, slots);
 }
 
 }  // namespace parafsi::fluid::detail

@@ -98,12 +98,14 @@ struct face_kernel {
 
   /// ALE Riemann flux from face values L (left/low side) and R at lane offsets.
   template <class V>
-  PARAFSI_INLINE cons<V> face_flux(const double* const* L, index_t oL, const double* const* R, index_t oR,
-                                   const V& wn, const vec3<double>& n) const noexcept {
-    const prim<V> wl{simd::load<V>(L[0] + oL), {simd::load<V>(L[1] + oL), simd::load<V>(L[2] + oL),
-                     simd::load<V>(L[3] + oL)}, simd::load<V>(L[4] + oL)};
-    const prim<V> wr{simd::load<V>(R[0] + oR), {simd::load<V>(R[1] + oR), simd::load<V>(R[2] + oR),
-                     simd::load<V>(R[3] + oR)}, simd::load<V>(R[4] + oR)};
+  PARAFSI_INLINE cons<V> face_flux(const double* const* L, index_t oL, const double* const* R, index_t oR, const V& wn,
+                                   const vec3<double>& n) const noexcept {
+    const prim<V> wl{simd::load<V>(L[0] + oL),
+                     {simd::load<V>(L[1] + oL), simd::load<V>(L[2] + oL), simd::load<V>(L[3] + oL)},
+                     simd::load<V>(L[4] + oL)};
+    const prim<V> wr{simd::load<V>(R[0] + oR),
+                     {simd::load<V>(R[1] + oR), simd::load<V>(R[2] + oR), simd::load<V>(R[3] + oR)},
+                     simd::load<V>(R[4] + oR)};
     return flux::ale_flux(flux, wl, wr, n, wn, gas);
   }
 };

@@ -18,8 +18,8 @@ namespace parafsi::fluid::detail {
 /// `bad`: one flag per interior row (n_y n_z), written when Check.
 template <bool Check>
 void update(const rectilinear_grid& grid, const gas::ideal& gas, const fields5<double>& U,
-            const fields5<const double>& U0, const fields5<const double>& dU, double a, double b, double dt,
-            char* bad, bool threaded) {
+            const fields5<const double>& U0, const fields5<const double>& dU, double a, double b, double dt, char* bad,
+            bool threaded) {
   const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
   const gas::ideal g = gas;
   par_for(threaded, 0, ny * nz, [&](index_t r) {
@@ -55,12 +55,12 @@ inline void check_rows(const rectilinear_grid& grid, const gas::ideal& g, const 
       const double p = g.pressure(q.rho, q.m.x, q.m.y, q.m.z, q.E);
       if (!(q.rho > 0.0) || !(p > 0.0) || !std::isfinite(p)) {
         const Eigen::Vector3d x = pose.to_inertial({grid.centre(0, i), grid.centre(1, j), grid.centre(2, k)});
-        throw numerical_failure(
-            parafsi::detail::concat("fluid::solver: non-physical state in cell (", i, ", ", j, ", ", k, ") at x = (",
-                                    x[0], ", ", x[1], ", ", x[2], ") m, t = ", t_new, " s: rho = ", q.rho,
-                                    " kg/m^3, p = ", p, " Pa, momentum = (", q.m.x, ", ", q.m.y, ", ", q.m.z,
-                                    "); reduce the time step (CFL) or check the set-up"),
-            grid.index(i, j, k), t_new);
+        throw numerical_failure(parafsi::detail::concat("fluid::solver: non-physical state in cell (", i, ", ", j, ", ",
+                                                        k, ") at x = (", x[0], ", ", x[1], ", ", x[2],
+                                                        ") m, t = ", t_new, " s: rho = ", q.rho, " kg/m^3, p = ", p,
+                                                        " Pa, momentum = (", q.m.x, ", ", q.m.y, ", ", q.m.z,
+                                                        "); reduce the time step (CFL) or check the set-up"),
+                                grid.index(i, j, k), t_new);
       }
     }
   }

@@ -11,9 +11,8 @@
 namespace parafsi::flux {
 
 template <class Flux, class V>
-PARAFSI_INLINE fluid::cons<V> ale_flux(const Flux& flux, fluid::prim<V> L, fluid::prim<V> R,
-                                       const vec3<double>& n, const V& wn,
-                                       const gas::ideal& g) noexcept {
+PARAFSI_INLINE fluid::cons<V> ale_flux(const Flux& flux, fluid::prim<V> L, fluid::prim<V> R, const vec3<double>& n,
+                                       const V& wn, const gas::ideal& g) noexcept {
   L.u = axpy_n(L.u, -wn, n);
   R.u = axpy_n(R.u, -wn, n);
   fluid::cons<V> F = flux(L, R, n, g);

@@ -24,8 +24,8 @@ struct ausm_plus_up {
   static constexpr const char* name() noexcept { return "ausm_plus_up"; }
 
   template <class V>
-  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R,
-                                           const vec3<double>& n, const gas::ideal& g) const noexcept {
+  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R, const vec3<double>& n,
+                                           const gas::ideal& g) const noexcept {
     using namespace fluid;
     using simd::select;
     const V unL = dot(L.u, n), unR = dot(R.u, n);
@@ -53,14 +53,11 @@ struct ausm_plus_up {
     const auto subR = simd::abs(MR) < V(1.0);
     const V M4p = select(subL, M2p(ML) * (V(1.0) - V(16.0) * beta * M2m(ML)), M1p(ML));
     const V M4m = select(subR, M2m(MR) * (V(1.0) + V(16.0) * beta * M2p(MR)), M1m(MR));
-    const V P5p = select(subL, M2p(ML) * ((V(2.0) - ML) - V(16.0) * alpha * ML * M2m(ML)),
-                         M1p(ML) / ML);
-    const V P5m = select(subR, M2m(MR) * ((V(-2.0) - MR) + V(16.0) * alpha * MR * M2p(MR)),
-                         M1m(MR) / MR);
+    const V P5p = select(subL, M2p(ML) * ((V(2.0) - ML) - V(16.0) * alpha * ML * M2m(ML)), M1p(ML) / ML);
+    const V P5m = select(subR, M2m(MR) * ((V(-2.0) - MR) + V(16.0) * alpha * MR * M2p(MR)), M1m(MR) / MR);
     const V rho_half = V(0.5) * (L.rho + R.rho);
     const V Mhalf = M4p + M4m -
-                    V(Kp) / fa * simd::max(V(1.0) - V(sigma) * Mbar2, V(0.0)) * (R.p - L.p) /
-                        (rho_half * a * a);
+                    V(Kp) / fa * simd::max(V(1.0) - V(sigma) * Mbar2, V(0.0)) * (R.p - L.p) / (rho_half * a * a);
     const V phalf = P5p * L.p + P5m * R.p - V(Ku) * P5p * P5m * (L.rho + R.rho) * fa * a * (unR - unL);
     const auto up = Mhalf > V(0.0);
     const V mdot = a * Mhalf * select(up, L.rho, R.rho);

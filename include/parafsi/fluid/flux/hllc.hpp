@@ -17,8 +17,8 @@ struct hllc {
   static constexpr const char* name() noexcept { return "hllc"; }
 
   template <class V>
-  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R,
-                                           const vec3<double>& n, const gas::ideal& g) const noexcept {
+  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R, const vec3<double>& n,
+                                           const gas::ideal& g) const noexcept {
     using fluid::select;
     const auto h = detail::hllc_prepare(L, R, n, g);
     const auto FsL = h.FL + (h.UsL - h.UL) * h.SL;

@@ -22,8 +22,8 @@ struct hllc_waves {
 /// Wave speeds, star states and the two side fluxes, with one reciprocal per density
 /// and per star denominator (divisions dominate the cost of this kernel).
 template <class V>
-PARAFSI_INLINE hllc_waves<V> hllc_prepare(const fluid::prim<V>& L, const fluid::prim<V>& R,
-                                          const vec3<double>& n, const gas::ideal& g) noexcept {
+PARAFSI_INLINE hllc_waves<V> hllc_prepare(const fluid::prim<V>& L, const fluid::prim<V>& R, const vec3<double>& n,
+                                          const gas::ideal& g) noexcept {
   using namespace fluid;
   hllc_waves<V> h;
   h.unL = dot(L.u, n);

@@ -22,16 +22,16 @@
 /// References: Fleischmann N., Adami S., Adams N.A. (2020) J. Comput. Phys. 423:109762,
 ///   doi:10.1016/j.jcp.2020.109762.
 #pragma once
-#include "../../core/policy.hpp"
 #include <numbers>
+#include "../../core/policy.hpp"
 
 #include "hllc_common.hpp"
 
 namespace parafsi::flux {
 
 struct hllc_lm {
-  double mach_limit = 0.1;  ///< M_lim: below it the acoustic dissipation is scaled down
-  double phi_min = 1.0;      ///< acoustic floor: φ ≥ φ_min · r, r the acoustic sensor (see above)
+  double mach_limit = 0.1;     ///< M_lim: below it the acoustic dissipation is scaled down
+  double phi_min = 1.0;        ///< acoustic floor: φ ≥ φ_min · r, r the acoustic sensor (see above)
   double acoustic_band = 2.0;  ///< K: jumps with |Δp| > K ρc|Δu_n| are not acoustic (walls, membranes)
 
   using policy_kind = kind::flux;
@@ -42,16 +42,16 @@ struct hllc_lm {
   template <class V>
   static PARAFSI_INLINE V sin_half_pi(const V& x) noexcept {
     constexpr double a = 0.5 * std::numbers::pi;
-    constexpr double c1 = a, c3 = -a * a * a / 6, c5 = a * a * a * a * a / 120,
-                     c7 = -a * a * a * a * a * a * a / 5040, c9 = a * a * a * a * a * a * a * a * a / 362880;
+    constexpr double c1 = a, c3 = -a * a * a / 6, c5 = a * a * a * a * a / 120, c7 = -a * a * a * a * a * a * a / 5040,
+                     c9 = a * a * a * a * a * a * a * a * a / 362880;
     const V x2 = x * x;
     const V s = x * (V(c1) + x2 * (V(c3) + x2 * (V(c5) + x2 * (V(c7) + x2 * V(c9)))));
     return simd::select(x >= V(1.0), V(1.0), s);
   }
 
   template <class V>
-  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R,
-                                           const vec3<double>& n, const gas::ideal& g) const noexcept {
+  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R, const vec3<double>& n,
+                                           const gas::ideal& g) const noexcept {
     using fluid::select;
     const auto h = detail::hllc_prepare(L, R, n, g);
     // M_loc = max(|u_nL|/c_L, |u_nR|/c_R) with one division.
@@ -67,7 +67,8 @@ struct hllc_lm {
     const V phi = simd::max(phi0, V(phi_min) * r);
     const auto central = (h.FL + h.FR) * V(0.5) +
                          ((h.UsL - h.UL) * (phi * h.SL) + (h.UsL - h.UsR) * simd::abs(h.Sstar) +
-                          (h.UsR - h.UR) * (phi * h.SR)) * V(0.5);
+                          (h.UsR - h.UR) * (phi * h.SR)) *
+                             V(0.5);
     return select<V>(h.SL >= V(0.0), h.FL, select<V>(h.SR <= V(0.0), h.FR, central));
   }
 };

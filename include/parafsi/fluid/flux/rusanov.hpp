@@ -15,8 +15,8 @@ struct rusanov {
   static constexpr const char* name() noexcept { return "rusanov"; }
 
   template <class V>
-  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R,
-                                           const vec3<double>& n, const gas::ideal& g) const noexcept {
+  PARAFSI_INLINE fluid::cons<V> operator()(const fluid::prim<V>& L, const fluid::prim<V>& R, const vec3<double>& n,
+                                           const gas::ideal& g) const noexcept {
     using namespace fluid;
     const V unL = dot(L.u, n), unR = dot(R.u, n);
     const V cL = g.sound_speed(L.rho, L.p), cR = g.sound_speed(R.rho, R.p);

@@ -13,8 +13,8 @@
 /// The payload's state is an input: call `track(x, v)` with the target's position
 /// and velocity at the end of the coming step before each `step(dt)`.
 #pragma once
-#include "../../core/policy.hpp"
 #include <cmath>
+#include "../../core/policy.hpp"
 
 #include "pose.hpp"
 

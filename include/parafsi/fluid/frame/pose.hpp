@@ -18,10 +18,10 @@ struct motion {
 };
 
 struct pose {
-  Eigen::Vector3d X = Eigen::Vector3d::Zero();       ///< box origin (m, inertial)
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();   ///< box axes as columns
-  Eigen::Vector3d V = Eigen::Vector3d::Zero();       ///< velocity of the box origin (m/s)
-  Eigen::Vector3d Omega = Eigen::Vector3d::Zero();   ///< angular velocity (rad/s, inertial)
+  Eigen::Vector3d X = Eigen::Vector3d::Zero();      ///< box origin (m, inertial)
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  ///< box axes as columns
+  Eigen::Vector3d V = Eigen::Vector3d::Zero();      ///< velocity of the box origin (m/s)
+  Eigen::Vector3d Omega = Eigen::Vector3d::Zero();  ///< angular velocity (rad/s, inertial)
 
   Eigen::Vector3d to_inertial(const Eigen::Vector3d& xi) const { return X + R * xi; }
   Eigen::Vector3d to_box(const Eigen::Vector3d& x) const { return R.transpose() * (x - X); }

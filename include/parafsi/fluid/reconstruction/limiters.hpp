@@ -35,8 +35,7 @@ struct mc {
   static constexpr const char* name() noexcept { return "mc"; }
   template <class V>
   PARAFSI_INLINE V operator()(const V& a, const V& b) const noexcept {
-    const V m = simd::min(simd::min(V(2.0) * simd::abs(a), V(2.0) * simd::abs(b)),
-                          V(0.5) * simd::abs(a + b));
+    const V m = simd::min(simd::min(V(2.0) * simd::abs(a), V(2.0) * simd::abs(b)), V(0.5) * simd::abs(a + b));
     return simd::select(a * b > V(0.0), simd::copysign(m, a), V(0.0));
   }
 };

@@ -40,7 +40,8 @@ struct isentropic_vortex {
     const double T_inf = p_inf / rho_inf;
     const double T = T_inf - (gamma - 1.0) * eps * eps / (8.0 * gamma * pi * pi) * std::exp(1.0 - r2);
     const double ratio = T / T_inf;
-    return {rho_inf * std::pow(ratio, 1.0 / (gamma - 1.0)), {u_inf - a * dy, v_inf + a * dx, 0.0},
+    return {rho_inf * std::pow(ratio, 1.0 / (gamma - 1.0)),
+            {u_inf - a * dy, v_inf + a * dx, 0.0},
             p_inf * std::pow(ratio, gamma / (gamma - 1.0))};
   }
 };
@@ -71,7 +72,8 @@ struct gresho_vortex {
 struct taylor_green_2d {
   double U = 1.0, rho = 1.0, p0 = 100.0;
   prim<double> operator()(double x, double y) const {
-    return {rho, {U * std::sin(x) * std::cos(y), -U * std::cos(x) * std::sin(y), 0.0},
+    return {rho,
+            {U * std::sin(x) * std::cos(y), -U * std::cos(x) * std::sin(y), 0.0},
             p0 + 0.25 * rho * U * U * (std::cos(2 * x) + std::cos(2 * y))};
   }
   /// Kinetic energy ratio E(t)/E(0) of the viscous decay (incompressible limit).

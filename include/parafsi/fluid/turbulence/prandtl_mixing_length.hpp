@@ -9,8 +9,8 @@
 /// References: Prandtl L. (1925) ZAMM 5:136; Wilcox D.C., Turbulence Modeling for CFD,
 ///   3rd ed., ch. 3; Pope S.B. (2000) Turbulent Flows, §10.3.
 #pragma once
-#include "../../core/policy.hpp"
 #include "../../core/error.hpp"
+#include "../../core/policy.hpp"
 #include "../../core/simd.hpp"
 
 namespace parafsi::turbulence {
@@ -20,12 +20,12 @@ struct prandtl_mixing_length {
   static constexpr bool needs_wall_distance = true;
   using policy_kind = kind::turbulence;
   static constexpr const char* name() noexcept { return "prandtl_mixing_length"; }
-  double kappa = 0.41;          ///< von Kármán constant
-  double c_l = 0.07;            ///< mixing length / reference length in free shear flows
-  double ref_length = 1.0;      ///< L_ref (m), e.g. the canopy's nominal diameter D0
-  double c_delta = 1.0;         ///< cap: l_m ≤ C_Δ Δ (grid scale)
-  double prandtl_t = 0.9;       ///< turbulent Prandtl number
-  double mu_cap = 1.79e-2;      ///< upper bound on μ_t (Pa s), 1000 × air's μ by default
+  double kappa = 0.41;      ///< von Kármán constant
+  double c_l = 0.07;        ///< mixing length / reference length in free shear flows
+  double ref_length = 1.0;  ///< L_ref (m), e.g. the canopy's nominal diameter D0
+  double c_delta = 1.0;     ///< cap: l_m ≤ C_Δ Δ (grid scale)
+  double prandtl_t = 0.9;   ///< turbulent Prandtl number
+  double mu_cap = 1.79e-2;  ///< upper bound on μ_t (Pa s), 1000 × air's μ by default
 
   void validate() const {
     require(kappa > 0 && c_l > 0 && ref_length > 0 && c_delta > 0,
@@ -34,8 +34,7 @@ struct prandtl_mixing_length {
   template <class V>
   PARAFSI_INLINE V eddy_viscosity(const V& rho, const V& S_norm, const V& delta,
                                   const V& wall_distance) const noexcept {
-    const V lm = simd::min(simd::min(V(kappa) * wall_distance, V(c_l * ref_length)),
-                           V(c_delta) * delta);
+    const V lm = simd::min(simd::min(V(kappa) * wall_distance, V(c_l * ref_length)), V(c_delta) * delta);
     return simd::min(rho * lm * lm * S_norm, V(mu_cap));
   }
 };

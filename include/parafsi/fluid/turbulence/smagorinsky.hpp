@@ -3,8 +3,8 @@
 /// C_s = 0.1 for shear flows (0.17 for isotropic turbulence).
 /// Reference: Smagorinsky J. (1963) Mon. Weather Rev. 91:99.
 #pragma once
-#include "../../core/policy.hpp"
 #include "../../core/error.hpp"
+#include "../../core/policy.hpp"
 #include "../../core/simd.hpp"
 
 namespace parafsi::turbulence {

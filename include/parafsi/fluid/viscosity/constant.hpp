@@ -2,8 +2,8 @@
 /// Constant dynamic viscosity μ and Prandtl number Pr (heat conductivity
 /// k = c_p μ / Pr). The paper's air: μ = 1.79e-5 Pa s.
 #pragma once
-#include "../../core/policy.hpp"
 #include "../../core/error.hpp"
+#include "../../core/policy.hpp"
 
 namespace parafsi::viscosity {
 

@@ -83,7 +83,9 @@ class corner_forces {
 
   /// Add the total force to the nodes, and when Track the damping and external parts.
   template <bool Track>
-  void scatter(nodes& nd) const { scatter_.scatter<Track>(nd, total, damping, external); }
+  void scatter(nodes& nd) const {
+    scatter_.scatter<Track>(nd, total, damping, external);
+  }
 
   /// Strain energy of the last tracked pass (J).
   double strain_energy() const { return ordered_sum(energy_part); }

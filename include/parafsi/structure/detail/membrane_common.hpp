@@ -62,8 +62,8 @@ template <std::size_t K>
 void check_reference_finite(const char* part, index_t e, const std::array<Eigen::Vector3d, K>& X,
                             const std::array<index_t, K>& nodes_of) {
   for (std::size_t a = 0; a < K; ++a)
-    require(X[a].allFinite(), part, ": element ", e, " has a non-finite reference position at node ", nodes_of[a],
-            " (", X[a].x(), ", ", X[a].y(), ", ", X[a].z(), ")");
+    require(X[a].allFinite(), part, ": element ", e, " has a non-finite reference position at node ", nodes_of[a], " (",
+            X[a].x(), ", ", X[a].y(), ", ", X[a].z(), ")");
 }
 
 /// Without a given reference, the node positions at the first finalize become the
@@ -145,8 +145,7 @@ PARAFSI_INLINE V membrane_energy(const V& at, const V& S11, const V& S22, const 
 /// Green–Lagrange strain (E11, E22, 2E12) and filtered elastic stress (S11, S22, S12)
 /// for output and tests.
 template <class Fabric>
-std::array<double, 6> strain_stress_of(const Fabric& mat, const fabric_moduli& q, double E11, double E22,
-                                       double E12) {
+std::array<double, 6> strain_stress_of(const Fabric& mat, const fabric_moduli& q, double E11, double E22, double E12) {
   double S11, S22, S12, D11 = 0, D22 = 0, D12 = 0;
   elastic_stress(q, E11, E22, E12, S11, S22, S12);
   mat.wrinkling.apply(S11, S22, S12, D11, D22, D12, E11, E22, E12, q);

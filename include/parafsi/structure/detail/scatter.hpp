@@ -42,7 +42,11 @@ inline void for_each_chunk(index_t n, F&& f) {
 /// Three components of per-corner forces, K corners per element.
 struct corner_buffer {
   simd::aligned_vector<double> x, y, z;
-  void resize(std::size_t n) { x.assign(n, 0.0); y.assign(n, 0.0); z.assign(n, 0.0); }
+  void resize(std::size_t n) {
+    x.assign(n, 0.0);
+    y.assign(n, 0.0);
+    z.assign(n, 0.0);
+  }
   bool finite_at(std::size_t s) const { return std::isfinite(x[s]) && std::isfinite(y[s]) && std::isfinite(z[s]); }
 };
 
@@ -65,7 +69,8 @@ class corner_scatter {
         slots_[std::size_t(pos[std::size_t(node)]++)] = index_t(c) * n_pad + e;
       }
     // Keep only touched nodes.
-    rows_.clear(); offsets_.clear();
+    rows_.clear();
+    offsets_.clear();
     for (index_t i = 0; i < n_nodes; ++i)
       if (count[std::size_t(i) + 1] > count[std::size_t(i)]) {
         rows_.push_back(i);
@@ -78,16 +83,22 @@ class corner_scatter {
   void add(double* fx, double* fy, double* fz, const corner_buffer& b) const {
     const index_t nr = index_t(rows_.size());
     const index_t* PARAFSI_RESTRICT sl = slots_.data();
-    const double* bx = b.x.data(); const double* by = b.y.data(); const double* bz = b.z.data();
+    const double* bx = b.x.data();
+    const double* by = b.y.data();
+    const double* bz = b.z.data();
     for_each_chunk(nr, [&](index_t begin, index_t end, index_t) {
       for (index_t r = begin; r < end; ++r) {
         double sx = 0, sy = 0, sz = 0;
         for (index_t k = offsets_[std::size_t(r)]; k < offsets_[std::size_t(r) + 1]; ++k) {
           const index_t s = sl[k];
-          sx += bx[s]; sy += by[s]; sz += bz[s];
+          sx += bx[s];
+          sy += by[s];
+          sz += bz[s];
         }
         const index_t i = rows_[std::size_t(r)];
-        fx[i] += sx; fy[i] += sy; fz[i] += sz;
+        fx[i] += sx;
+        fy[i] += sy;
+        fz[i] += sz;
       }
     });
   }

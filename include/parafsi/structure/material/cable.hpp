@@ -26,8 +26,8 @@ struct cable {
   double linear_density() const { return mass_per_length; }
   void validate() const {
     require(EA > 0 && std::isfinite(EA), "material::cable: EA must be > 0, got ", EA);
-    require(mass_per_length >= 0 && std::isfinite(mass_per_length), "material::cable: mass per length must be >= 0, got ",
-            mass_per_length);
+    require(mass_per_length >= 0 && std::isfinite(mass_per_length),
+            "material::cable: mass per length must be >= 0, got ", mass_per_length);
     require(damping_ratio >= 0 && damping_ratio < 1, "material::cable: damping ratio must be in [0, 1), got ",
             damping_ratio);
     require(preload >= 0 && std::isfinite(preload), "material::cable: preload must be >= 0, got ", preload);
@@ -36,12 +36,12 @@ struct cable {
 
 /// A woven tape: EA = E·w·t, ρ_l = ρ·w·t.
 struct tape {
-  double E = 0;               ///< effective Young's modulus along the tape (Pa)
-  double width = 0;           ///< w (m)
-  double thickness = 0;       ///< t (m)
-  double density = 0;         ///< ρ (kg/m³)
-  double damping_ratio = 0;   ///< ξ
-  double preload = 0;         ///< T0 (N)
+  double E = 0;              ///< effective Young's modulus along the tape (Pa)
+  double width = 0;          ///< w (m)
+  double thickness = 0;      ///< t (m)
+  double density = 0;        ///< ρ (kg/m³)
+  double damping_ratio = 0;  ///< ξ
+  double preload = 0;        ///< T0 (N)
 
   static constexpr const char* name() { return "tape"; }
   double axial_stiffness() const { return E * width * thickness; }

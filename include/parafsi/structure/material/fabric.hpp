@@ -50,9 +50,8 @@ struct fabric {
     require(areal_density > 0 && std::isfinite(areal_density), "material::fabric: areal density must be > 0, got ",
             areal_density);
     const double nu21 = nu12 * E22 / E11;
-    require(std::isfinite(nu12) && 1.0 - nu12 * nu21 > 0.0,
-            "material::fabric: Poisson ratio nu12 = ", nu12, " gives a non-positive-definite law (1 - nu12 nu21 = ",
-            1.0 - nu12 * nu21, ")");
+    require(std::isfinite(nu12) && 1.0 - nu12 * nu21 > 0.0, "material::fabric: Poisson ratio nu12 = ", nu12,
+            " gives a non-positive-definite law (1 - nu12 nu21 = ", 1.0 - nu12 * nu21, ")");
     if constexpr (requires { wrinkling.validate(); }) wrinkling.validate();
   }
 

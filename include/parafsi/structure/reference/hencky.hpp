@@ -23,11 +23,11 @@
 namespace parafsi::structure::reference {
 
 struct hencky_solution {
-  double nu;                 ///< Poisson ratio
-  double s0;                 ///< dimensionless centre stress s(0)
-  double coefficient;        ///< f(ν) = w0 / (a (qa/Eh)^{1/3})
-  std::vector<double> x;     ///< r/a, uniform on [0, 1]
-  std::vector<double> w;     ///< w(r) / (a (qa/Eh)^{1/3})
+  double nu;              ///< Poisson ratio
+  double s0;              ///< dimensionless centre stress s(0)
+  double coefficient;     ///< f(ν) = w0 / (a (qa/Eh)^{1/3})
+  std::vector<double> x;  ///< r/a, uniform on [0, 1]
+  std::vector<double> w;  ///< w(r) / (a (qa/Eh)^{1/3})
 };
 
 namespace hencky_detail {
@@ -37,7 +37,9 @@ inline void shoot(double s0, int n, double& s1, double& ds1, std::vector<double>
   const double x0 = 1e-4;
   double x = x0, s = s0 - x0 * x0 / (8.0 * s0 * s0), d = -x0 / (4.0 * s0 * s0);
   const double h = (1.0 - x0) / n;
-  if (prof) { prof->assign(1, s0); }
+  if (prof) {
+    prof->assign(1, s0);
+  }
   auto f = [](double xx, double ss, double dd, double& a, double& b) {
     a = dd;
     b = -1.0 / (ss * ss) - 3.0 * dd / xx;
@@ -52,7 +54,11 @@ inline void shoot(double s0, int n, double& s1, double& ds1, std::vector<double>
     d += h / 6.0 * (k1b + 2 * k2b + 2 * k3b + k4b);
     x += h;
     if (prof) prof->push_back(s);
-    if (!(s > 0)) { s1 = -1; ds1 = 0; return; }
+    if (!(s > 0)) {
+      s1 = -1;
+      ds1 = 0;
+      return;
+    }
   }
   s1 = s;
   ds1 = d;

@@ -7,7 +7,7 @@
 namespace parafsi::structure {
 
 struct fabric_moduli {
-  double E1, E2, nu12, G12;  ///< warp/weft Young's moduli, major Poisson ratio, shear modulus (Pa)
+  double E1, E2, nu12, G12;   ///< warp/weft Young's moduli, major Poisson ratio, shear modulus (Pa)
   double Q11, Q12, Q22, Q66;  ///< plane-stress stiffness [S11,S22,S12] = Q [E11,E22,2E12]
 };
 

@@ -11,8 +11,8 @@ struct none {
   static constexpr const char* name() { return "none"; }
   void validate() const {}
   template <class V>
-  PARAFSI_INLINE void apply(V&, V&, V&, V&, V&, V&, const V&, const V&, const V&,
-                            const fabric_moduli&) const noexcept {}
+  PARAFSI_INLINE void apply(V&, V&, V&, V&, V&, V&, const V&, const V&, const V&, const fabric_moduli&) const noexcept {
+  }
 };
 
 }  // namespace parafsi::structure::wrinkling

@@ -24,8 +24,8 @@ struct stress_elimination {
   double residual = 1e-3;  ///< r_c: fraction of compressive stress kept
   static constexpr const char* name() { return "stress_elimination"; }
   void validate() const {
-    require(residual >= 0.0 && residual <= 1.0, "wrinkling::stress_elimination: residual factor must be in [0, 1], got ",
-            residual);
+    require(residual >= 0.0 && residual <= 1.0,
+            "wrinkling::stress_elimination: residual factor must be in [0, 1], got ", residual);
   }
   /// Filter the elastic stress S and viscous stress D in place (strain E unused).
   template <class V>
@@ -43,8 +43,12 @@ struct stress_elimination {
     const V Dp = P11 * D11 + P22 * D22 + V(2.0) * P12 * D12;
     const V kd = simd::select(wr, V(1.0 - residual) * Dp, V(0.0));
     const V f = simd::select(slack, V(residual), V(1.0));
-    S11 = (S11 - k * P11) * f; S22 = (S22 - k * P22) * f; S12 = (S12 - k * P12) * f;
-    D11 = (D11 - kd * P11) * f; D22 = (D22 - kd * P22) * f; D12 = (D12 - kd * P12) * f;
+    S11 = (S11 - k * P11) * f;
+    S22 = (S22 - k * P22) * f;
+    S12 = (S12 - k * P12) * f;
+    D11 = (D11 - kd * P11) * f;
+    D22 = (D22 - kd * P22) * f;
+    D12 = (D12 - kd * P12) * f;
   }
 };
 

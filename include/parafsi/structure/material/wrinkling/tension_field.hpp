@@ -30,8 +30,8 @@ struct tension_field {
             residual);
   }
   template <class V>
-  PARAFSI_INLINE void apply(V& S11, V& S22, V& S12, V& D11, V& D22, V& D12, const V& E11, const V& E22,
-                            const V& E12, const fabric_moduli& q) const noexcept {
+  PARAFSI_INLINE void apply(V& S11, V& S22, V& S12, V& D11, V& D22, V& D12, const V& E11, const V& E22, const V& E12,
+                            const fabric_moduli& q) const noexcept {
     // Elastic principal stresses (criterion only).
     const V hs = V(0.5) * (S11 + S22), ds = V(0.5) * (S11 - S22);
     const V s2 = hs - simd::sqrt(ds * ds + S12 * S12);

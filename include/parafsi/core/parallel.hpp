@@ -55,6 +55,7 @@ inline void for_range(index_t begin, index_t end, F&& f, bool threaded = true) {
 #pragma omp parallel for schedule(static) if (threaded)
   for (index_t i = begin; i < end; ++i) f(i);
 #else
+  (void)threaded;
   for (index_t i = begin; i < end; ++i) f(i);
 #endif
 }

@@ -52,6 +52,18 @@ TEST_CASE("embedded: the membrane Riemann problem (wall, series layers, transpar
   CHECK(s1.up == doctest::Approx(ex.u_star()).epsilon(1e-8));
   CHECK(s1.psL == doctest::Approx(ex.p_star()).epsilon(1e-8));
   CHECK(s1.psR == doctest::Approx(ex.p_star()).epsilon(1e-8));
+  // A face whose air is no longer a gas stops with the states and the cause, not a NaN.
+  for (const double bad : {std::nan(""), -1.0}) {
+    try {
+      (void)por.solve_face(1.2, 0.3, 101400.0, 1.2, 0.1, bad, 0.05, 1);
+      FAIL("no exception");
+    } catch (const pf::numerical_failure& e) {
+      const std::string m = e.what();
+      CAPTURE(m);
+      CHECK(m.find("no longer a gas") != std::string::npos);
+      CHECK(m.find("right rho=1.2") != std::string::npos);
+    }
+  }
 }
 
 TEST_CASE("embedded: a membrane moving faster than a cell per step is rejected with a message") {

@@ -55,6 +55,14 @@ TEST_CASE("porosity: bad parameters are rejected with the value") {
   CHECK_THROWS_WITH_AS((pf::porosity::ergun{1.0, 1.0, 0.0}.validate()), doctest::Contains("thickness"),
                        pf::invalid_input);
   CHECK_THROWS_AS((pf::porosity::ergun{0.0, 0.0, 1e-4}.validate()), pf::invalid_input);
+  // Penalty stiffening below 0.01 cell outgrows the substep bound within a step: refused.
+  pf::coupling::penalty_options po;
+  po.stiffening = 0.005;
+  CHECK_THROWS_WITH_AS(po.validate(), doctest::Contains("stiffening must be 0 (off) or >= 0.01"), pf::invalid_input);
+  po.stiffening = 0.01;
+  CHECK_NOTHROW(po.validate());
+  po.max_cells_per_step = std::nan("");
+  CHECK_THROWS_AS(po.validate(), pf::invalid_input);
   CHECK_THROWS_AS((pf::porosity::darcy{0.0, 1e-4}.validate()), pf::invalid_input);
   CHECK_THROWS_WITH_AS(pf::model::fabric("mat000"), doctest::Contains("unknown fabric 'mat000'"), pf::invalid_input);
 }

@@ -331,6 +331,24 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     }
   }
 
+  /// A face whose membrane Riemann problem has no solution: name the states and the cause.
+  [[noreturn]] static void fail_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
+                                     double g0) {
+    const bool gas = std::isfinite(rL) && std::isfinite(pL) && std::isfinite(unL) && std::isfinite(rR) &&
+                     std::isfinite(pR) && std::isfinite(unR) && rL > 0 && pL > 0 && rR > 0 && pR > 0;
+    throw numerical_failure(parafsi::detail::concat(
+        "coupling::embedded: no through-velocity solves a membrane face (pressure balance at zero through-flow ",
+        g0, "): ",
+        gas ? "the fabric's pressure jump cannot balance the wall pressures (a porosity law that is not monotone "
+              "or not finite?)"
+            : "the air next to the membrane is no longer a gas (density or pressure <= 0 or not finite): the "
+              "membrane moved too far in one step or the start is too violent; shorten the step (lower CFL or "
+              "pressure-gradient scaling) or lower the initial speed",
+        "; left rho=", rL, " u_n=", unL, " p=", pL, ", right rho=", rR, " u_n=", unR, " p=", pR,
+        ", membrane w=", w, " m/s"),
+                            -1, std::numeric_limits<double>::quiet_NaN());
+  }
+
   /// The membrane Riemann problem of one face: through-velocity u_p (relative to the
   /// membrane) and the two wall pressures, given the normal velocities of the cell
   /// states, the membrane's normal velocity w and k layers.
@@ -350,6 +368,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
       return g;
     };
     const double g0 = eval(0.0, s);
+    if (!std::isfinite(g0)) fail_face(rL, unL, pL, rR, unR, pR, w, g0);
     if constexpr (!Porosity::permeable) {
       return s;
     } else {
@@ -367,7 +386,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
         b *= 2.0;
         gb = eval(b, sb);
       }
-      require(gb * sgn <= 0, "coupling::embedded: no bracket for the through-velocity (g0 = ", g0, ")");
+      if (!(gb * sgn <= 0)) fail_face(rL, unL, pL, rR, unR, pR, w, g0);
       if (gb == 0.0) return sb;
       // Illinois (modified regula falsi) on [a, b], ga and gb of opposite signs.
       int side = 0;

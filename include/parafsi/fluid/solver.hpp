@@ -138,7 +138,7 @@ class solver {
       require(plo == phi, "fluid::solver: periodic boundary on axis ", d, " must be set on both faces");
       if (!plo) require(grid_.n(d) >= 2, "fluid::solver: axis ", d, " needs >= 2 cells with non-periodic faces");
     }
-    require(bc_.layer.cells >= 0, "fluid::solver: sponge cells must be >= 0");
+    bc_.validate();
     const index_t N = grid_.total_cells();
     U_.resize(N, 0.0);
     U0_.resize(N, 0.0);
@@ -210,7 +210,7 @@ class solver {
   const frame::pose& pose() const noexcept { return pose_; }
   Frame& frame() noexcept { return frame_; }
   const Frame& frame() const noexcept { return frame_; }
-  boundary::set& boundaries() noexcept { return bc_; }
+  const boundary::set& boundaries() const noexcept { return bc_; }
   const gas::ideal& gas() const noexcept { return gas_; }
   const Flux& flux() const noexcept { return flux_; }
   const rectilinear_grid& grid() const noexcept { return grid_; }

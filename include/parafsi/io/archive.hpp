@@ -74,6 +74,7 @@
 #include "../core/error.hpp"
 #include "../core/simd.hpp"
 #include "../core/soa.hpp"
+#include "checked_file.hpp"
 
 namespace parafsi::io {
 
@@ -589,29 +590,21 @@ class checkpoint_file {
   std::vector<std::string> order_;
 };
 
-/// Write the archive's payload to `path` atomically: `<path>.tmp`, then a rename.
+/// Write the archive's payload to `path` atomically: `<path>.tmp`, synced to disk, then a
+/// rename (io::write_file_atomic); a failed open, write, sync or close names the file.
 inline void write_checkpoint_file(const std::filesystem::path& path, const output_archive& ar) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
   const auto& buf = ar.bytes();
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    require(out.good(), "io::save_checkpoint: cannot open ", tmp.string(), " for writing");
-    const std::uint32_t version = checkpoint_version, order = 0x01020304u;
-    const std::uint64_t len = buf.size(), sum = ckpt::fnv1a(buf.data(), buf.size());
-    out.write(checkpoint_magic.data(), std::streamsize(checkpoint_magic.size()));
-    out.write(reinterpret_cast<const char*>(&version), 4);
-    out.write(reinterpret_cast<const char*>(&order), 4);
-    out.write(reinterpret_cast<const char*>(&len), 8);
-    out.write(reinterpret_cast<const char*>(buf.data()), std::streamsize(buf.size()));
-    out.write(reinterpret_cast<const char*>(&sum), 8);
-    out.flush();
-    require(out.good(), "io::save_checkpoint: writing ", tmp.string(), " failed (disk full?)");
-    out.close();
-    require(!out.fail(), "io::save_checkpoint: closing ", tmp.string(), " failed");
-  }
-  std::filesystem::rename(tmp, path);
+  const std::uint32_t version = checkpoint_version, order = 0x01020304u;
+  const std::uint64_t len = buf.size(), sum = ckpt::fnv1a(buf.data(), buf.size());
+  write_file_atomic(path, [&](checked_file& f) {
+    const auto put = [&f](const void* p, std::size_t n) { f.write({static_cast<const char*>(p), n}); };
+    put(checkpoint_magic.data(), checkpoint_magic.size());
+    put(&version, 4);
+    put(&order, 4);
+    put(&len, 8);
+    put(buf.data(), buf.size());
+    put(&sum, 8);
+  });
 }
 
 }  // namespace parafsi::io

@@ -11,9 +11,15 @@
 /// Writes go through C stdio (a buffered FILE*): a write may only fail at the next flush
 /// or at close, which is why `close()` must be called; the destructor closes a file that
 /// was not closed (after an exception elsewhere) without reporting.
-/// io/ is never included by physics headers; this one needs the standard library only.
+/// `sync()` asks the system to put the bytes on the disk (POSIX fsync; a no-op where
+/// <unistd.h> is missing), and `write_file_atomic` writes `<path>.tmp`, syncs it and renames
+/// it over `path`, so a reader (or a restart after a power cut) sees the old file or the
+/// new one, never a torn one.
+/// io/ is never included by physics headers; this one needs the standard library only
+/// (and <unistd.h> where the system has it).
 #pragma once
 #include <cerrno>
+#include <concepts>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -22,6 +28,11 @@
 #include <utility>
 
 #include "../core/error.hpp"
+
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#define PARAFSI_HAVE_FSYNC 1
+#endif
 
 namespace parafsi::io {
 
@@ -56,6 +67,15 @@ class checked_file {
     require_open();
     errno = 0;
     if (std::fflush(f_) != 0) fail("cannot write", errno);
+  }
+  /// Flush, then ask the system to write the file's data to the disk (fsync) before
+  /// returning: used before the rename of an atomic write.
+  void sync() {
+    flush();
+#ifdef PARAFSI_HAVE_FSYNC
+    errno = 0;
+    if (::fsync(::fileno(f_)) != 0) fail("cannot sync", errno);
+#endif
   }
   /// Flush and close; the file is complete only if this returns.
   void close() {
@@ -92,6 +112,30 @@ inline void write_text_file(const std::filesystem::path& path, std::string_view 
   checked_file f(path);
   f.write(text);
   f.close();
+}
+
+/// Write a file atomically: `write(f)` fills `<path>.tmp` through the checked file `f`, which
+/// is then synced to disk and renamed over `path` (the parent directory is created if
+/// missing). A reader, or a restart after a crash or power cut, sees the old file or the new
+/// one, never a torn one; any failure throws io::write_error naming the file.
+template <class Write>
+  requires std::invocable<Write&, checked_file&>
+void write_file_atomic(const std::filesystem::path& path, Write&& write) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    checked_file f(tmp);
+    write(f);
+    f.sync();
+    f.close();
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+/// Write `text` to `path` atomically (see above).
+inline void write_file_atomic(const std::filesystem::path& path, std::string_view text) {
+  write_file_atomic(path, [text](checked_file& f) { f.write(text); });
 }
 
 }  // namespace parafsi::io

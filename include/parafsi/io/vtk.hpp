@@ -201,15 +201,6 @@ inline std::string time_field_data(double t, xml_out& x) {
   return "    <FieldData>\n" + x.s + "    </FieldData>\n";
 }
 
-/// Write `text` to `path` through `path.tmp` (a checked file) + rename.
-inline void write_file_atomic(const std::filesystem::path& path, const std::string& text) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  write_text_file(tmp, text);  // checked open, write and close (io::write_error naming the file)
-  std::filesystem::rename(tmp, path);
-}
-
 template <class A>
 concept element_part = requires(const A& p, index_t e) {
   p.element(e);
@@ -325,7 +316,7 @@ void write_vtu(const std::filesystem::path& path, const Assembly& a, const vtu_o
   x.array("types", 1, types, 8);
   s += "      <Cells>\n" + x.s + "      </Cells>\n";
   s += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
-  detail::write_file_atomic(path, s);
+  io::write_file_atomic(path, s);
 }
 
 // ============================================================== fluid (.vts, slices)
@@ -416,7 +407,7 @@ void write_vts(const std::filesystem::path& path, const Solver& s, const vtk_opt
   x.array("Points", 3, pts, 8);
   out += "      <Points>\n" + x.s + "      </Points>\n";
   out += "    </Piece>\n  </StructuredGrid>\n</VTKFile>\n";
-  detail::write_file_atomic(path, out);
+  io::write_file_atomic(path, out);
 }
 
 /// Mid-plane slice as CSV `x,y,z,rho,u,v,w,p,vorticity_normal` (see the file comment).
@@ -479,7 +470,7 @@ std::size_t write_midplane_csv(const std::filesystem::path& path, const Solver& 
       num(om.dot(nrm), true);
       ++rows;
     }
-  detail::write_file_atomic(path, out);
+  io::write_file_atomic(path, out);
   return rows;
 }
 
@@ -546,7 +537,7 @@ class pvd_writer {
            "\" file=\"" + e.file + "\"/>\n";
     }
     s += "  </Collection>\n</VTKFile>\n";
-    detail::write_file_atomic(path_, s);
+    io::write_file_atomic(path_, s);
   }
   std::filesystem::path path_;
   std::vector<entry> entries_;

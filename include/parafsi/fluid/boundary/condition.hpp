@@ -5,6 +5,7 @@
 /// to far-field faces, σ rising as a cubic from 0 to σ_max = strength · c_∞ / L_sponge.
 #pragma once
 #include <array>
+#include <cmath>
 #include <string>
 #include <variant>
 
@@ -13,6 +14,7 @@
 #include "outflow.hpp"
 #include "periodic.hpp"
 #include "slip_wall.hpp"
+#include "../../core/error.hpp"
 
 namespace parafsi::boundary {
 
@@ -21,6 +23,20 @@ using condition = std::variant<far_field, slip_wall, periodic, inflow, outflow>;
 inline std::string name_of(const condition& c) {
   return std::visit([](const auto& b) { return std::string(b.name()); }, c);
 }
+
+namespace detail {
+/// A prescribed state (far field, inflow) must be a gas: ρ > 0, p > 0, all finite.
+template <class B>
+void validate_state(const B& b, const char* face) {
+  require(std::isfinite(b.rho) && b.rho > 0, "boundary::", b.name(), " on face ", face,
+          ": density must be finite and > 0, got ", b.rho);
+  require(std::isfinite(b.p) && b.p > 0, "boundary::", b.name(), " on face ", face,
+          ": pressure must be finite and > 0, got ", b.p);
+  for (int d = 0; d < 3; ++d)
+    require(std::isfinite(b.u[d]), "boundary::", b.name(), " on face ", face, ": velocity component ", d,
+            " must be finite, got ", b.u[d]);
+}
+}  // namespace detail
 
 struct sponge {
   int cells = 0;          ///< sponge thickness in cells (0: off)
@@ -44,6 +60,20 @@ struct set {
   set& side(int d, int hi, const condition& c) {
     face[std::size_t(2 * d + hi)] = c;
     return *this;
+  }
+  /// Refuse states that are not a gas and a sponge that is not a damping (the solver
+  /// calls this at construction), naming the face and the value.
+  void validate() const {
+    static constexpr const char* names[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+    for (std::size_t f = 0; f < 6; ++f)
+      std::visit(
+          [&](const auto& b) {
+            if constexpr (requires { b.rho, b.p, b.u; }) detail::validate_state(b, names[f]);
+          },
+          face[f]);
+    require(layer.cells >= 0, "boundary::sponge: cells must be >= 0, got ", layer.cells);
+    require(std::isfinite(layer.strength) && layer.strength >= 0,
+            "boundary::sponge: strength must be finite and >= 0, got ", layer.strength);
   }
 };
 

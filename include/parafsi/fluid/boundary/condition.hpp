@@ -32,9 +32,10 @@ void validate_state(const B& b, const char* face) {
           ": density must be finite and > 0, got ", b.rho);
   require(std::isfinite(b.p) && b.p > 0, "boundary::", b.name(), " on face ", face,
           ": pressure must be finite and > 0, got ", b.p);
+  const double u[3] = {b.u.x, b.u.y, b.u.z};
   for (int d = 0; d < 3; ++d)
-    require(std::isfinite(b.u[d]), "boundary::", b.name(), " on face ", face, ": velocity component ", d,
-            " must be finite, got ", b.u[d]);
+    require(std::isfinite(u[d]), "boundary::", b.name(), " on face ", face, ": velocity component ", d,
+            " must be finite, got ", u[d]);
 }
 }  // namespace detail
 

@@ -72,15 +72,15 @@ inline st::triangle_mesh sheet_mesh(const pf::model::duct_screen_scene& d) {
   return tm;
 }
 
-/// Mean pressure and x-velocity, and the total mass, of the cells of a (n × 2 × 2) duct with
+/// Mean pressure and x-velocity, and the total mass, of the cells of a duct (n × m × 2) with
 /// centres strictly between x = a and x = b.
 template <class S>
 void window_means(const S& s, double a, double b, double& p, double& u, double& mass) {
   const auto& g = s.fluid().grid();
   p = u = mass = 0;
   int n = 0;
-  for (pf::index_t k = 0; k < 2; ++k)
-    for (pf::index_t j = 0; j < 2; ++j)
+  for (pf::index_t k = 0; k < g.n(2); ++k)
+    for (pf::index_t j = 0; j < g.n(1); ++j)
       for (pf::index_t i = 0; i < g.n(0); ++i) {
         const double x = g.centre(0, i);
         if (x <= a || x >= b) continue;

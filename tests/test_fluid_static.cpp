@@ -85,12 +85,21 @@ TEST_CASE("bad input is rejected with a message naming the value") {
   expect([&] { fluid::solver t{grid, boundary::set::all(boundary::periodic{}), gas::ideal{0.9, 287.0}}; }, "gamma");
   expect([&] { fluid::solver t{grid, boundary::set::all(boundary::periodic{}), viscosity::constant{-1.0}}; }, "mu");
   // Prescribed boundary states must be a gas, named by face; the sponge must damp.
-  expect([&] { fluid::solver t{grid, boundary::set{}.side(2, 1, boundary::far_field{std::nan(""), {0, 0, 0}, 1e5})}; },
-         "far_field on face z+: density");
-  expect([&] { fluid::solver t{grid, boundary::set{}.side(0, 0, boundary::far_field{1.2, {0, 0, 0}, 0.0})}; },
-         "far_field on face x-: pressure");
-  expect([&] { fluid::solver t{grid, boundary::set{}.side(1, 0, boundary::inflow{1.2, {0, HUGE_VAL, 0}, 1e5})}; },
-         "inflow on face y-: velocity component 1");
+  expect(
+      [&] {
+    fluid::solver t{grid, boundary::set{}.side(2, 1, boundary::far_field{std::nan(""), {0, 0, 0}, 1e5})};
+      },
+      "far_field on face z+: density");
+  expect(
+      [&] {
+    fluid::solver t{grid, boundary::set{}.side(0, 0, boundary::far_field{1.2, {0, 0, 0}, 0.0})};
+      },
+      "far_field on face x-: pressure");
+  expect(
+      [&] {
+    fluid::solver t{grid, boundary::set{}.side(1, 0, boundary::inflow{1.2, {0, HUGE_VAL, 0}, 1e5})};
+      },
+      "inflow on face y-: velocity component 1");
   expect(
       [&] {
     boundary::set b;

@@ -367,4 +367,24 @@ TEST_CASE("duct screen: cubic cells, the sheet spans the cross-section at x_s wi
   CHECK(msg.find("1.5") != std::string::npos);
   CHECK_THROWS_AS(md::duct_screen(1.0, 1, 0.5), pf::invalid_input);
   CHECK_THROWS_AS(md::duct_screen(-1.0, 40, 0.5), pf::invalid_input);
+  // Inclined by 30° about z in a duct 8 cells wide: area W_y W / cos θ, normal (cos θ, −sin θ, 0).
+  const auto q = md::duct_screen(1.0, 40, 0.5, 2, 30.0, 8);
+  CHECK(q.cells == std::array<index_t, 3>{40, 8, 2});
+  CHECK(q.width_y == doctest::Approx(0.2).epsilon(1e-15));
+  CHECK(q.sheet_area() == doctest::Approx(0.2 * 0.05 / std::cos(M_PI / 6)).epsilon(1e-14));
+  double qa = 0;
+  for (const auto& t : q.sheet.triangles) {
+    const Eigen::Vector3d a = q.sheet.positions[std::size_t(t[0])], b = q.sheet.positions[std::size_t(t[1])],
+                          c = q.sheet.positions[std::size_t(t[2])];
+    const Eigen::Vector3d n = 0.5 * (b - a).cross(c - a);
+    CHECK(n.normalized().isApprox(Eigen::Vector3d(std::cos(M_PI / 6), -std::sin(M_PI / 6), 0.0), 1e-14));
+    qa += n.norm();
+  }
+  CHECK(qa == doctest::Approx(q.sheet_area()).epsilon(1e-14));
+  for (const auto& x : q.sheet.positions) {
+    CHECK(x.x() >= 0.5 - 0.1 * std::tan(M_PI / 6) - 1e-15);
+    CHECK(x.x() <= 0.5 + 0.1 * std::tan(M_PI / 6) + 1e-15);
+  }
+  CHECK_THROWS_AS(md::duct_screen(1.0, 40, 0.5, 2, 85.0, 8), pf::invalid_input);
+  CHECK_THROWS_AS(md::duct_screen(1.0, 40, 0.5, 2, 0.0, 3), pf::invalid_input);
 }

@@ -103,9 +103,9 @@ TEST_CASE("closed-form free-top period: elliptic integral and limits") {
   struct k_case {
     double k, K;
   };
-  for (const k_case c : {k_case{0.0, 1.57079632679489661923}, k_case{0.3, 1.60804861993051279836},
-                         k_case{0.9, 2.28054913842277030049}, k_case{0.999, 4.49559639584214372788},
-                         k_case{0.999999, 7.94747977354796703267}}) {
+  for (const k_case c :
+       {k_case{0.0, 1.57079632679489661923}, k_case{0.3, 1.60804861993051279836}, k_case{0.9, 2.28054913842277030049},
+        k_case{0.999, 4.49559639584214372788}, k_case{0.999999, 7.94747977354796703267}}) {
     const double K = complete_elliptic_k_from_complement(std::sqrt((1 - c.k) * (1 + c.k)));
     CHECK(std::abs(K - c.K) < 1e-14 * c.K);
     // libstdc++'s comp_ellint_1 (Carlson R_F) is accurate to ≈ 1e-12 near k = 1 only when

@@ -21,7 +21,19 @@
 /// u_m = w + u_p. Each side sees a piston moving at u_m: its wall pressure p*_K comes
 /// from the exact one-sided Riemann problem (Toro §4.2: rarefaction or shock branch,
 /// both inverted in closed form). The fabric law closes the system:
-///   p*_L(u_m) − p*_R(u_m) = k Δp_por(u_p)          (k layers in series)
+///   p*_L(u_m) − p*_R(u_m) = Σ_l Δp_por(u_n,l)      (the face's layers l in series)
+/// with the law on each layer's own normal through-velocity, not on the face's: layer l
+/// with unit normal m_l (turned to n's side, c_l = m_l·n > 0) and velocity v_l at the
+/// crossing sees the air's velocity relative to it, u_p n + t along n and across it (t
+/// the transverse part of the mean of the two cells' velocities, relative to v_l), so
+///   u_n,l = c_l u_p + o_l,   o_l = c_l (w − n·v_l − n·r_l) + m_l·r_l,   r_l = ½(u_L + u_R) − v_l.
+/// A cloth inclined to the grid crosses a staircase of faces of every axis d, of total
+/// area A Σ_d |m_d|; this rule makes each face pass the component of the through-flow
+/// along its own normal, so the faces pass A u_n in all, a uniform stream crosses an
+/// inclined screen undeflected (faces nearly parallel to the cloth pass only what its
+/// tangential flow carries) and the pressure drop is the law at the cloth's normal
+/// velocity. For a layer normal to the face (c = 1, no transverse flow) it is
+/// Δp = k Δp_por(u_p).
 /// The left side falls and the right rises with u_m, the law rises with u_p, so the
 /// root is unique; it is bracketed and found by the Illinois method. For
 /// `porosity::impermeable` u_p = 0 (an exact moving wall). As the resistance → 0 this
@@ -336,27 +348,40 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
                                      double g0) {
     const bool gas = std::isfinite(rL) && std::isfinite(pL) && std::isfinite(unL) && std::isfinite(rR) &&
                      std::isfinite(pR) && std::isfinite(unR) && rL > 0 && pL > 0 && rR > 0 && pR > 0;
-    throw numerical_failure(parafsi::detail::concat(
-        "coupling::embedded: no through-velocity solves a membrane face (pressure balance at zero through-flow ",
-        g0, "): ",
-        gas ? "the fabric's pressure jump cannot balance the wall pressures (a porosity law that is not monotone "
-              "or not finite?)"
-            : "the air next to the membrane is no longer a gas (density or pressure <= 0 or not finite): the "
-              "membrane moved too far in one step or the start is too violent; shorten the step (lower CFL or "
-              "pressure-gradient scaling) or lower the initial speed",
-        "; left rho=", rL, " u_n=", unL, " p=", pL, ", right rho=", rR, " u_n=", unR, " p=", pR,
-        ", membrane w=", w, " m/s"),
-                            -1, std::numeric_limits<double>::quiet_NaN());
+    throw numerical_failure(
+        parafsi::detail::concat(
+            "coupling::embedded: no through-velocity solves a membrane face (pressure balance at zero through-flow ",
+            g0, "): ",
+            gas ? "the fabric's pressure jump cannot balance the wall pressures (a porosity law that is not monotone "
+                  "or not finite?)"
+                : "the air next to the membrane is no longer a gas (density or pressure <= 0 or not finite): the "
+                  "membrane moved too far in one step or the start is too violent; shorten the step (lower CFL or "
+                  "pressure-gradient scaling) or lower the initial speed",
+            "; left rho=", rL, " u_n=", unL, " p=", pL, ", right rho=", rR, " u_n=", unR, " p=", pR, ", membrane w=", w,
+            " m/s"),
+        -1, std::numeric_limits<double>::quiet_NaN());
   }
 
   /// The membrane Riemann problem of one face: through-velocity u_p (relative to the
-  /// membrane) and the two wall pressures, given the normal velocities of the cell
-  /// states, the membrane's normal velocity w and k layers.
+  /// membrane, along the face normal) and the two wall pressures, given the normal
+  /// velocities of the cell states, the membrane's normal velocity w and k layers
+  /// normal to the face (Δp = k Δp_por(u_p)).
   struct face_solution {
     double up = 0, psL = 0, rsL = 0, psR = 0, rsR = 0;
   };
   face_solution solve_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
                            int layers) const {
+    return solve_face_law(rL, unL, pL, rR, unR, pR, w, [&](double up) {
+      if constexpr (Porosity::permeable) return double(layers) * por_.pressure_jump(up);
+      else return 0.0;
+    });
+  }
+
+ private:
+  /// The root of p*_L(w + u_p) − p*_R(w + u_p) = jump(u_p), jump rising in u_p.
+  template <class Jump>
+  face_solution solve_face_law(double rL, double unL, double pL, double rR, double unR, double pR, double w,
+                               Jump&& jump) const {
     face_solution s;
     auto eval = [&](double up, face_solution& o) {
       const double um = w + up;
@@ -364,7 +389,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
       wall_state(rR, pR, gamma_, um - unR, o.psR, o.rsR);
       o.up = up;
       double g = o.psL - o.psR;
-      if constexpr (Porosity::permeable) g -= double(layers) * por_.pressure_jump(up);
+      if constexpr (Porosity::permeable) g -= jump(up);
       return g;
     };
     const double g0 = eval(0.0, s);
@@ -413,13 +438,15 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     }
   }
 
- private:
   struct crossing {
     index_t elem;
     std::array<double, 3> lambda;  ///< barycentric weights of the crossing point
     double z;                      ///< crossing coordinate along the face axis (box)
     double wn = 0;                 ///< membrane velocity at the crossing · face normal (m/s)
     double sign = 1;               ///< sign of n_element · n_face
+    double cosine = 1;             ///< c = |m · n_face| of the element's unit normal m
+    Eigen::Vector3d m{1, 0, 0};    ///< the element's unit normal, turned to n_face's side
+    Eigen::Vector3d vm{0, 0, 0};   ///< membrane velocity at the crossing (m/s)
   };
   struct face_rec {
     index_t high;
@@ -498,6 +525,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
       }
       const Eigen::Vector3d ne = (nd.position(t[1]) - nd.position(t[0])).cross(nd.position(t[2]) - nd.position(t[0]));
       area_ += 0.5 * (X[1] - X[0]).cross(X[2] - X[0]).norm();
+      const Eigen::Vector3d ne_unit = ne.normalized();
       Eigen::Vector3d lo = X[0].cwiseMin(X[1]).cwiseMin(X[2]), hi = X[0].cwiseMax(X[1]).cwiseMax(X[2]);
       for (int d = 0; d < 3; ++d) {
         if (g.n(d) < 2) continue;
@@ -543,6 +571,9 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
               const Eigen::Vector3d nf = pose.R.col(d);
               cr.wn = nf.dot(cr.lambda[0] * Vn[0] + cr.lambda[1] * Vn[1] + cr.lambda[2] * Vn[2]);
               cr.sign = ne.dot(nf) >= 0 ? 1.0 : -1.0;
+              cr.m = cr.sign * ne_unit;
+              cr.cosine = cr.m.dot(nf);
+              cr.vm = cr.lambda[0] * Vn[0] + cr.lambda[1] * Vn[1] + cr.lambda[2] * Vn[2];
               found.push_back({g.index(ijk[0], ijk[1], ijk[2]), d, cr});
             }
           }
@@ -604,7 +635,19 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     state(fc.low, rL, uL, pL);
     state(fc.high, rR, uR, pR);
     const double unL = uL.dot(n), unR = uR.dot(n);
-    const face_solution s = solve_face(rL, unL, pL, rR, unR, pR, w, fr.n);
+    // The fabric law on each layer's own normal through-velocity u_n,l = c_l u_p + o_l (file comment).
+    const Eigen::Vector3d ub = 0.5 * (uL + uR);
+    const face_solution s = solve_face_law(rL, unL, pL, rR, unR, pR, w, [&](double up) {
+      double dp = 0;
+      if constexpr (Porosity::permeable)
+        for (int q = 0; q < fr.n; ++q) {
+          const crossing& cr = crossings_[std::size_t(fr.first + q)];
+          const Eigen::Vector3d rel = ub - cr.vm;
+          const double o = cr.cosine * (w - n.dot(cr.vm) - rel.dot(n)) + rel.dot(cr.m);
+          dp += por_.pressure_jump(cr.cosine * up + o);
+        }
+      return dp;
+    });
     const double um = w + s.up, sw = w - fc.wn;
     const Eigen::Vector3d usL = uL + (um - unL) * n, usR = uR + (um - unR) * n;
     const double g1 = 1.0 / (gamma_ - 1.0);

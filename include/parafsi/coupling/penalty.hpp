@@ -77,7 +77,8 @@ struct penalty_options {
 
   void validate() const {
     require(std::isfinite(pfac) && pfac > 0, "coupling::penalty: PFAC must be > 0, got ", pfac);
-    require(damping_ratio >= 0 && damping_ratio <= 1,  // NaN fails both "coupling::penalty: damping ratio must be in [0, 1], got ",
+    require(damping_ratio >= 0 &&
+                damping_ratio <= 1,  // NaN fails both "coupling::penalty: damping ratio must be in [0, 1], got ",
             damping_ratio);
     // The stable substep is bounded with the stiffness at tⁿ; with λ < 0.01 the factor
     // 1 + (d/(λh))² grows by more than 10⁴ while d moves by one hundredth of a cell inside
@@ -86,7 +87,8 @@ struct penalty_options {
             "coupling::penalty: stiffening must be 0 (off) or >= 0.01, got ", stiffening,
             " (a smaller lambda makes the stiffness grow faster within one step than the stable substep allows)");
     require(fluid_cap >= 0 && std::isfinite(fluid_cap), "coupling::penalty: fluid_cap must be >= 0, got ", fluid_cap);
-    require(std::isfinite(max_cells_per_step) && max_cells_per_step > 0, "coupling::penalty: max_cells_per_step must be > 0, got ", max_cells_per_step);
+    require(std::isfinite(max_cells_per_step) && max_cells_per_step > 0,
+            "coupling::penalty: max_cells_per_step must be > 0, got ", max_cells_per_step);
     points.validate();
   }
 };

@@ -119,7 +119,7 @@ inline void write_text_file(const std::filesystem::path& path, std::string_view 
 /// missing). A reader, or a restart after a crash or power cut, sees the old file or the new
 /// one, never a torn one; any failure throws io::write_error naming the file.
 template <class Write>
-  requires std::invocable<Write&, checked_file&>
+requires std::invocable<Write&, checked_file&>
 void write_file_atomic(const std::filesystem::path& path, Write&& write) {
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::filesystem::path tmp = path;

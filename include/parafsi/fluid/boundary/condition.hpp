@@ -9,12 +9,12 @@
 #include <string>
 #include <variant>
 
+#include "../../core/error.hpp"
 #include "far_field.hpp"
 #include "inflow.hpp"
 #include "outflow.hpp"
 #include "periodic.hpp"
 #include "slip_wall.hpp"
-#include "../../core/error.hpp"
 
 namespace parafsi::boundary {
 
@@ -69,7 +69,7 @@ struct set {
     for (std::size_t f = 0; f < 6; ++f)
       std::visit(
           [&](const auto& b) {
-            if constexpr (requires { b.rho, b.p, b.u; }) detail::validate_state(b, names[f]);
+        if constexpr (requires { b.rho, b.p, b.u; }) detail::validate_state(b, names[f]);
           },
           face[f]);
     require(layer.cells >= 0, "boundary::sponge: cells must be >= 0, got ", layer.cells);

@@ -14,8 +14,8 @@
 /// Crossings of one face at the same z (a segment through a shared edge or vertex)
 /// count once. Elements marked open (vents) are skipped.
 ///
-/// Face flux (per unit area; n the face normal, low → high; first-order cell states
-/// L, R on each side; w = n·v_s the membrane's normal velocity at the crossing, the
+/// Face flux (per unit area; n the face normal, low → high; states L, R on each side, the
+/// cells' own or one-sided reconstructed (OneSided); w = n·v_s the membrane's normal velocity at the crossing, the
 /// mean over the layers; w_g the grid's normal speed). Unknown: the through-velocity
 /// u_p of the air relative to the membrane; the air at the membrane moves at
 /// u_m = w + u_p. Each side sees a piston moving at u_m: its wall pressure p*_K comes
@@ -24,16 +24,18 @@
 ///   p*_L(u_m) − p*_R(u_m) = Σ_l Δp_por(u_n,l)      (the face's layers l in series)
 /// with the law on each layer's own normal through-velocity, not on the face's: layer l
 /// with unit normal m_l (turned to n's side, c_l = m_l·n > 0) and velocity v_l at the
-/// crossing sees the air's velocity relative to it, u_p n + t along n and across it (t
-/// the transverse part of the mean of the two cells' velocities, relative to v_l), so
-///   u_n,l = c_l u_p + o_l,   o_l = c_l (w − n·v_l − n·r_l) + m_l·r_l,   r_l = ½(u_L + u_R) − v_l.
+/// crossing sees the air cross it at u_n,l m_l + s_l: the normal part from the law and
+/// the part s_l along the cloth from the cells (s_l the part of r_l = ½(u_L + u_R) − v_l
+/// along the cloth, r_l − (r_l·m_l) m_l). Its component along n is the face's relative
+/// velocity u_p + w − n·v_l, so
+///   u_n,l = (u_p + o_l) / c_l,   o_l = w − n·v_l − s_l·n.
 /// A cloth inclined to the grid crosses a staircase of faces of every axis d, of total
-/// area A Σ_d |m_d|; this rule makes each face pass the component of the through-flow
-/// along its own normal, so the faces pass A u_n in all, a uniform stream crosses an
-/// inclined screen undeflected (faces nearly parallel to the cloth pass only what its
-/// tangential flow carries) and the pressure drop is the law at the cloth's normal
-/// velocity. For a layer normal to the face (c = 1, no transverse flow) it is
-/// Δp = k Δp_por(u_p).
+/// area A Σ_d |m_d|; each face then passes the component of the through-velocity along its
+/// own normal, so the faces pass A u_n in all, a uniform stream crosses an inclined screen
+/// undeflected, and the pressure drop is the law at the cloth's normal velocity. A face
+/// nearly parallel to the cloth (c → 0) becomes stiff: it passes what the cloth's
+/// tangential flow carries (u_p → s·n) and leaves the pressure jump to the faces that
+/// face the cloth. For a layer normal to the face (c = 1, s·n = 0) it is Δp = k Δp_por(u_p).
 /// The left side falls and the right rises with u_m, the law rises with u_p, so the
 /// root is unique; it is bracketed and found by the Illinois method. For
 /// `porosity::impermeable` u_p = 0 (an exact moving wall). As the resistance → 0 this
@@ -63,8 +65,10 @@
 /// isolate that cell (it keeps its own state), which is stable. A membrane that moves
 /// more than `max_cells_per_step` cells relative to the grid in a step is rejected.
 /// Only faces between two interior cells are patched: a membrane in the outermost half
-/// cell of the box is not seen. The cell states next to the membrane are first order
-/// (the solver's MUSCL slopes of those cells still see across the membrane).
+/// cell of the box is not seen. By default the states L, R are the cells' own (first order)
+/// and the solver's MUSCL slopes of those cells read across the membrane; with
+/// `embedded<P, true>` the cells beside it are reconstructed from their own side
+/// (`one_sided_reconstruction`, fluid/detail/patch_faces.hpp): L, R are second order.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -125,9 +129,12 @@ struct embedded_diagnostics {
   std::vector<double> through_flow;  ///< per element: Σ u_p A_face/k along +n_e (m³/s), last stage
 };
 
-template <class Porosity = porosity::impermeable>
-class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, embedded_options> {
-  using base = detail::membrane_coupling<embedded<Porosity>, Porosity, embedded_options>;
+/// `OneSided`: reconstruct the cells beside a membrane face from their own side (second
+/// order up to the membrane; see `one_sided_reconstruction`). Off by default: on a curved,
+/// flexible porous sheet it removes the damping that lets the sheet settle (docs/coupling.md).
+template <class Porosity = porosity::impermeable, bool OneSided = false>
+class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, Porosity, embedded_options> {
+  using base = detail::membrane_coupling<embedded<Porosity, OneSided>, Porosity, embedded_options>;
   using base::attached_;
   using base::opt_;
   using base::por_;
@@ -135,6 +142,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
  public:
   /// The fluid step runs before the structure substeps (the loads come from its fluxes).
   static constexpr bool fluid_first = true;
+  /// With OneSided, the cells beside a membrane face are reconstructed from their own side
+  /// only (fluid/detail/patch_faces.hpp) and the face states L, R are second order; without
+  /// it, L and R are the sweeps' two-sided values (their slopes read across the membrane).
+  static constexpr bool one_sided_reconstruction = OneSided;
   static constexpr const char* name() noexcept { return "embedded"; }
   using base::base;
 
@@ -201,6 +212,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     const auto& nd = s.node_set();
     const frame::pose& pose = f.pose();
     dt_f_ = dt_f;
+    t_n_ = f.time();
     gamma_ = f.gas().gamma;
     // Travel check (relative to the grid, per blocking element).
     for (index_t e = 0; e < index_t(tris_.size()); ++e) {
@@ -344,8 +356,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
   }
 
   /// A face whose membrane Riemann problem has no solution: name the states and the cause.
-  [[noreturn]] static void fail_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
-                                     double g0) {
+  [[noreturn]] void fail_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
+                              double g0) const {
     const bool gas = std::isfinite(rL) && std::isfinite(pL) && std::isfinite(unL) && std::isfinite(rR) &&
                      std::isfinite(pR) && std::isfinite(unR) && rL > 0 && pL > 0 && rR > 0 && pR > 0;
     throw numerical_failure(
@@ -358,8 +370,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
                   "membrane moved too far in one step or the start is too violent; shorten the step (lower CFL or "
                   "pressure-gradient scaling) or lower the initial speed",
             "; left rho=", rL, " u_n=", unL, " p=", pL, ", right rho=", rR, " u_n=", unR, " p=", pR, ", membrane w=", w,
-            " m/s"),
-        -1, std::numeric_limits<double>::quiet_NaN());
+            " m/s, in the fluid step from t = ", t_n_, " s"),
+        -1, t_n_);
   }
 
   /// The membrane Riemann problem of one face: through-velocity u_p (relative to the
@@ -624,27 +636,34 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
     double w = 0;
     for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
     w /= double(fr.n);
-    // Cell states on each side (first order).
-    auto state = [&](index_t c, double& r, Eigen::Vector3d& u, double& p) {
-      r = v.density(c);
-      u = v.velocity(c);
-      p = v.pressure(c);
-    };
+    // The face states on each side: one-sided reconstructed (OneSided), else the cells' own
+    // (first order: the sweeps' face values would carry slopes read across the membrane).
     double rL, pL, rR, pR;
     Eigen::Vector3d uL, uR;
-    state(fc.low, rL, uL, pL);
-    state(fc.high, rR, uR, pR);
+    if constexpr (OneSided) {
+      (void)v;
+      rL = fc.L.rho, pL = fc.L.p, rR = fc.R.rho, pR = fc.R.p;
+      uL = Eigen::Vector3d(fc.L.u.x, fc.L.u.y, fc.L.u.z);
+      uR = Eigen::Vector3d(fc.R.u.x, fc.R.u.y, fc.R.u.z);
+    } else {
+      rL = v.density(fc.low), uL = v.velocity(fc.low), pL = v.pressure(fc.low);
+      rR = v.density(fc.high), uR = v.velocity(fc.high), pR = v.pressure(fc.high);
+    }
     const double unL = uL.dot(n), unR = uR.dot(n);
-    // The fabric law on each layer's own normal through-velocity u_n,l = c_l u_p + o_l (file comment).
+    // The fabric law on each layer's own normal through-velocity u_n,l = (u_p + o_l) / c_l
+    // (file comment): o_l per layer, once per face and stage.
     const Eigen::Vector3d ub = 0.5 * (uL + uR);
+    auto offset = [&](const crossing& cr) {
+      const Eigen::Vector3d rel = ub - cr.vm;
+      const Eigen::Vector3d tang = rel - rel.dot(cr.m) * cr.m;  // along the cloth
+      return w - n.dot(cr.vm) - tang.dot(n);
+    };
     const face_solution s = solve_face_law(rL, unL, pL, rR, unR, pR, w, [&](double up) {
       double dp = 0;
       if constexpr (Porosity::permeable)
         for (int q = 0; q < fr.n; ++q) {
           const crossing& cr = crossings_[std::size_t(fr.first + q)];
-          const Eigen::Vector3d rel = ub - cr.vm;
-          const double o = cr.cosine * (w - n.dot(cr.vm) - rel.dot(n)) + rel.dot(cr.m);
-          dp += por_.pressure_jump(cr.cosine * up + o);
+          dp += por_.pressure_jump((up + offset(cr)) / cr.cosine);
         }
       return dp;
     });
@@ -687,7 +706,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
   std::vector<detail::triangle> tris_;
   std::vector<index_t> open_list_;
   std::vector<char> open_;
-  double dt_f_ = 0, gamma_ = 1.4, area_ = 0, total_kick_ = 1;
+  double dt_f_ = 0, t_n_ = 0, gamma_ = 1.4, area_ = 0, total_kick_ = 1;
   std::vector<face_rec> faces_;
   std::vector<crossing> crossings_;
   std::vector<Eigen::Vector3d> face_J_, node_J_, node_v0_;
@@ -701,8 +720,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity>, Porosity, 
 };
 
 template <class P>
-embedded(P) -> embedded<P>;
+embedded(P) -> embedded<P, false>;
 template <class P>
-embedded(P, embedded_options) -> embedded<P>;
+embedded(P, embedded_options) -> embedded<P, false>;
 
 }  // namespace parafsi::coupling

@@ -433,7 +433,7 @@ class solver {
       detail::sweep<2>(fk, geo, dU, bufs_, threaded_);
     });
     if (!patcher.patch_faces().empty())
-      timed(times_.fluxes, [&] { detail::patch_faces(fk, geo, view(), stage, dU, patcher); });
+      timed(times_.fluxes, [&] { detail::patch_faces(fk, geo, view(), stage, dU, patcher, blocked_); });
     if constexpr (is_viscous)
       timed(times_.viscous, [&] {
         detail::viscous_pass<Viscosity, Turbulence, viscous_storage, turbulence_storage>{visc_,       turb_,
@@ -474,6 +474,7 @@ class solver {
   }
 
   rectilinear_grid grid_;
+  std::vector<std::uint8_t> blocked_;  ///< faces blocked by one-sided patches (detail/patch_faces.hpp)
   boundary::set bc_;
   gas::ideal gas_;
   Flux flux_;

@@ -3,8 +3,24 @@
 /// (serial, deterministic), recompute the face's regular flux F from the stage's face
 /// values, ask the patcher for the one-sided fluxes F_lo, F_hi and correct the rates
 ///   dU_low += (F − F_lo)/Δx_low,   dU_high −= (F − F_hi)/Δx_high   (interior cells only).
+///
+/// One-sided reconstruction (patchers with `one_sided_reconstruction = true`, a membrane
+/// in the face): the sweeps' MUSCL slopes of the two cells beside a patched face read
+/// across it. For such a patcher the cells with a patched face along the axis are
+/// reconstructed from their own side only: a cell blocked on its high face takes
+///   Δ = limiter((W_i − W_{i−1})/δ_{i−½}, (W_{i−1} − W_{i−2})/δ_{i−3/2}) Δx_i/2
+/// (the second difference replaced by the first where face i − 3/2 is also blocked),
+/// mirrored for a low face; a cell blocked on both faces is first order; the positivity
+/// fallback is the sweeps'. The patcher sees these values as the face states L, R (second
+/// order up to the membrane), and the fluxes of the unblocked neighbouring faces
+/// (i − ½ of the low cell, i + 3/2 of the high one) are recomputed with them, the
+/// difference to the sweeps' flux moved between the two cells (conservative). Each such
+/// neighbouring face is corrected once: by the patch on its high cell's high face if there
+/// is one, else by the patch on its low cell's low face.
 #pragma once
+#include <cstdint>
 #include <span>
+#include <vector>
 
 #include "../../core/error.hpp"
 #include "../patch.hpp"
@@ -13,9 +29,109 @@
 
 namespace parafsi::fluid::detail {
 
+/// Whether a patcher asks for one-sided reconstruction beside its faces.
+template <class P>
+constexpr bool wants_one_sided() {
+  if constexpr (requires { P::one_sided_reconstruction; }) return P::one_sided_reconstruction;
+  else return false;
+}
+
+/// Face values of `cell` along D (flat index, index ia along D): the two-sided MUSCL
+/// values where neither face along D is blocked (bit 2D: low face, 2D + 1: high face of
+/// `blocked`), else the one-sided values of the file comment.
+template <int D, class Flux, class Recon>
+void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<std::uint8_t>& blocked, index_t cell,
+                        index_t ia, double* lo, double* hi) {
+  const index_t s = fk.grid.stride(D);
+  const std::uint8_t lo_bit = std::uint8_t(1u << (2 * D)), hi_bit = std::uint8_t(1u << (2 * D + 1));
+  const bool lo_b = blocked[std::size_t(cell)] & lo_bit, hi_b = blocked[std::size_t(cell)] & hi_bit;
+  if (!lo_b && !hi_b) {
+    double* pl[5] = {&lo[0], &lo[1], &lo[2], &lo[3], &lo[4]};
+    double* ph[5] = {&hi[0], &hi[1], &hi[2], &hi[3], &hi[4]};
+    fk.template cell_faces<D, double>(cell, s, ia, pl, ph, 0);
+    return;
+  }
+  double q[5];
+  for (int f = 0; f < 5; ++f) q[f] = fk.W[f][cell];
+  if constexpr (Recon::second_order) {
+    if (!(lo_b && hi_b)) {
+      const double* idc = fk.grid.inv_centre_gaps(D);
+      const double h = fk.grid.half_widths(D)[ia];
+      // Towards the open side: the near difference a and the next one b (or a again).
+      const index_t o = hi_b ? -s : s;  // step into the open side
+      const bool far_blocked = blocked[std::size_t(cell + o)] & (hi_b ? lo_bit : hi_bit);
+      const double ia_near = hi_b ? idc[ia] : idc[ia + 1], ia_far = hi_b ? idc[ia - 1] : idc[ia + 2];
+      const double sg = hi_b ? 1.0 : -1.0;  // differences taken low → high
+      bool bad = false;
+      double l[5], r[5];
+      for (int f = 0; f < 5; ++f) {
+        const double* w = fk.W[f];
+        const double a = sg * (w[cell] - w[cell + o]) * ia_near;
+        const double b = far_blocked ? a : sg * (w[cell + o] - w[cell + 2 * o]) * ia_far;
+        const double d = fk.recon.slope(a, b) * h;
+        l[f] = q[f] - d;
+        r[f] = q[f] + d;
+      }
+      bad = l[0] <= 0.0 || r[0] <= 0.0 || l[4] <= 0.0 || r[4] <= 0.0;
+      if (!bad) {
+        for (int f = 0; f < 5; ++f) {
+          lo[f] = l[f];
+          hi[f] = r[f];
+        }
+        return;
+      }
+    }
+  }
+  for (int f = 0; f < 5; ++f) lo[f] = hi[f] = q[f];
+}
+
+/// Two-sided face values of `cell` along D (what the sweeps used).
+template <int D, class Flux, class Recon>
+void sweep_cell_faces(const face_kernel<Flux, Recon>& fk, index_t cell, index_t ia, double* lo, double* hi) {
+  double* pl[5] = {&lo[0], &lo[1], &lo[2], &lo[3], &lo[4]};
+  double* ph[5] = {&hi[0], &hi[1], &hi[2], &hi[3], &hi[4]};
+  fk.template cell_faces<D, double>(cell, fk.grid.stride(D), ia, pl, ph, 0);
+}
+
+inline prim<double> prim_of(const double* v) { return {v[0], {v[1], v[2], v[3]}, v[4]}; }
+
+/// Recompute the unblocked face between cells a (low, index ia along D) and a + s with
+/// the one-sided values and move the difference to the sweeps' flux between the cells.
+template <int D, class Flux, class Recon>
+void correct_neighbour_face(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo,
+                            const std::vector<std::uint8_t>& blocked, index_t a, index_t ia,
+                            const fields5<double>& dU) {
+  const rectilinear_grid& grid = fk.grid;
+  const index_t s = grid.stride(D), b = a + s;
+  double la[5], ha[5], lb[5], hb[5], la1[5], ha1[5], lb1[5], hb1[5];
+  sweep_cell_faces<D>(fk, a, ia, la, ha);
+  sweep_cell_faces<D>(fk, b, ia + 1, lb, hb);
+  blocked_cell_faces<D>(fk, blocked, a, ia, la1, ha1);
+  blocked_cell_faces<D>(fk, blocked, b, ia + 1, lb1, hb1);
+  const vec3<double> n = geo.n[std::size_t(D)];
+  auto ijk = grid.ijk(b);
+  vec3<double> centre{grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
+  const double xf = grid.face(D, ijk[std::size_t(D)]);
+  if constexpr (D == 0) centre.x = xf;
+  else if constexpr (D == 1) centre.y = xf;
+  else centre.z = xf;
+  const Eigen::Vector3d cE(centre.x, centre.y, centre.z);
+  const double wn = geo.vh[D] + geo.oh.cross(cE)[D];
+  const cons<double> F0 = flux::ale_flux(fk.flux, prim_of(ha), prim_of(lb), n, wn, fk.gas);
+  const cons<double> F1 = flux::ale_flux(fk.flux, prim_of(ha1), prim_of(lb1), n, wn, fk.gas);
+  const double dF[5] = {F1.rho - F0.rho, F1.m.x - F0.m.x, F1.m.y - F0.m.y, F1.m.z - F0.m.z, F1.E - F0.E};
+  const double* idx = grid.inv_widths(D);
+  const bool a_in = ia >= 0, b_in = ia + 1 < grid.n(D);
+  for (int q = 0; q < 5; ++q) {
+    if (a_in) dU[q][a] -= dF[q] * idx[ia];
+    if (b_in) dU[q][b] += dF[q] * idx[ia + 1];
+  }
+}
+
 template <class Flux, class Recon, class Patcher>
 void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const view& state, int stage,
-                 const fields5<double>& dU, Patcher& patcher) {
+                 const fields5<double>& dU, Patcher& patcher, std::vector<std::uint8_t>& blocked) {
+  constexpr bool one_sided = wants_one_sided<Patcher>() && Recon::second_order;
   const rectilinear_grid& grid = fk.grid;
   const std::span<const patch_face> faces = patcher.patch_faces();
   for (std::size_t pi = 0; pi < faces.size(); ++pi) {
@@ -23,46 +139,84 @@ void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, 
     const int d = faces[pi].axis;
     require(d >= 0 && d < 3 && c >= grid.stride(d) && c < grid.total_cells(), "fluid::solver: bad patched face ", pi,
             " (cell ", c, ", axis ", d, ")");
+  }
+  // Faces with a ghost cell on either side keep the sweeps' values.
+  auto interior = [&](const patch_face& f) {
+    const index_t i = grid.ijk(f.high)[std::size_t(f.axis)];
+    return i >= 1 && i < grid.n(f.axis);
+  };
+  if constexpr (one_sided) {
+    if (blocked.size() != std::size_t(grid.total_cells())) blocked.assign(std::size_t(grid.total_cells()), 0);
+    for (const patch_face& f : faces) {
+      if (!interior(f)) continue;
+      blocked[std::size_t(f.high)] |= std::uint8_t(1u << (2 * f.axis));
+      blocked[std::size_t(f.high - grid.stride(f.axis))] |= std::uint8_t(1u << (2 * f.axis + 1));
+    }
+  }
+  for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+    const index_t c = faces[pi].high;
+    const int d = faces[pi].axis;
     const index_t s = grid.stride(d), m = c - s;
     const auto ijk = grid.ijk(c);  // axis indices of the high cell
+    const index_t ic = ijk[std::size_t(d)];
     double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
-    double* pl[5] = {&lo_m[0], &lo_m[1], &lo_m[2], &lo_m[3], &lo_m[4]};
-    double* ph[5] = {&hi_m[0], &hi_m[1], &hi_m[2], &hi_m[3], &hi_m[4]};
-    double* ql[5] = {&lo_c[0], &lo_c[1], &lo_c[2], &lo_c[3], &lo_c[4]};
-    double* qh[5] = {&hi_c[0], &hi_c[1], &hi_c[2], &hi_c[3], &hi_c[4]};
-    auto faces_of = [&](index_t cell, index_t ia, double** lo, double** hi) {
-      if (d == 0) fk.template cell_faces<0, double>(cell, s, ia, lo, hi, 0);
-      else if (d == 1) fk.template cell_faces<1, double>(cell, s, ia, lo, hi, 0);
-      else fk.template cell_faces<2, double>(cell, s, ia, lo, hi, 0);
+    auto with_axis = [&](auto&& fn) {
+      if (d == 0) fn(std::integral_constant<int, 0>{});
+      else if (d == 1) fn(std::integral_constant<int, 1>{});
+      else fn(std::integral_constant<int, 2>{});
     };
-    faces_of(m, ijk[std::size_t(d)] - 1, pl, ph);
-    faces_of(c, ijk[std::size_t(d)], ql, qh);
+    with_axis([&](auto D) {
+      sweep_cell_faces<decltype(D)::value>(fk, m, ic - 1, lo_m, hi_m);
+      sweep_cell_faces<decltype(D)::value>(fk, c, ic, lo_c, hi_c);
+    });
     face_context fc;
     fc.low = m;
     fc.high = c;
     fc.axis = d;
     fc.stage = stage;
     fc.patch = pi;
-    fc.L = {hi_m[0], {hi_m[1], hi_m[2], hi_m[3]}, hi_m[4]};
-    fc.R = {lo_c[0], {lo_c[1], lo_c[2], lo_c[3]}, lo_c[4]};
+    fc.L = prim_of(hi_m);
+    fc.R = prim_of(lo_c);
     fc.n = geo.n[std::size_t(d)];
     fc.centre = {grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
-    fc.centre[d] = grid.face(d, ijk[std::size_t(d)]);
+    fc.centre[d] = grid.face(d, ic);
     fc.wn = geo.vh[d] + geo.oh.cross(fc.centre)[d];
     const int a = (d + 1) % 3, b = (d + 2) % 3;
     fc.area = grid.width(a, ijk[std::size_t(a)]) * grid.width(b, ijk[std::size_t(b)]);
     const cons<double> F = flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
+    if (one_sided && interior(faces[pi])) {
+      // The membrane sees the one-sided face states; the unblocked neighbouring faces are
+      // recomputed with them (each once, see the file comment).
+      with_axis([&](auto D) {
+        double l1[5], h1[5];
+        blocked_cell_faces<decltype(D)::value>(fk, blocked, m, ic - 1, l1, h1);
+        fc.L = prim_of(h1);
+        blocked_cell_faces<decltype(D)::value>(fk, blocked, c, ic, l1, h1);
+        fc.R = prim_of(l1);
+        const std::uint8_t lo_bit = std::uint8_t(1u << (2 * d)), hi_bit = std::uint8_t(1u << (2 * d + 1));
+        if (!(blocked[std::size_t(m)] & lo_bit))
+          correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, m - s, ic - 2, dU);
+        if (!(blocked[std::size_t(c)] & hi_bit) && !(blocked[std::size_t(c + s)] & hi_bit))
+          correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, c, ic, dU);
+      });
+    }
     cons<double> Flo = F, Fhi = F;
     patcher.patch(fc, state, Flo, Fhi);
-    const double idm = grid.inv_widths(d)[ijk[std::size_t(d)] - 1], idc = grid.inv_widths(d)[ijk[std::size_t(d)]];
+    const double idm = grid.inv_widths(d)[ic - 1], idc = grid.inv_widths(d)[ic];
     const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
     const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
-    const bool m_interior = ijk[std::size_t(d)] - 1 >= 0, c_interior = ijk[std::size_t(d)] < grid.n(d);
+    const bool m_interior = ic - 1 >= 0, c_interior = ic < grid.n(d);
     for (int q = 0; q < 5; ++q) {
       if (m_interior) dU[q][m] += dlo[q] * idm;
       if (c_interior) dU[q][c] -= dhi[q] * idc;
     }
   }
+  if constexpr (one_sided)
+    for (const patch_face& f : faces) {
+      if (!interior(f)) continue;
+      blocked[std::size_t(f.high)] = 0;
+      blocked[std::size_t(f.high - grid.stride(f.axis))] = 0;
+    }
 }
 
 }  // namespace parafsi::fluid::detail

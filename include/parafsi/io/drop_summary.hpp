@@ -376,18 +376,19 @@ inline descent_statistics classify_descent(std::span<const drop_history_row> w, 
       d.swing_period = 2.0 * (c.back() - c.front()) / double(c.size() - 1);
       d.periods = d.duration / d.swing_period;
     }
-    if (!(double(c.size()) >= 2.0 * o.min_periods && d.periods >= o.min_periods)) {
-      d.mode = "undetermined";
-      return d;
-    }
-    // Signed turning of q about the mean, off the centre band.
+    // Signed turning of q about the mean, off the centre band (reported also when the
+    // window is too short to judge).
     const double band = o.centre_band * std::sqrt(tr);
     double turn = 0;
     for (std::size_t k = 0; k + 1 < n; ++k)
       if (q[k].norm() >= band && q[k + 1].norm() >= band)
         turn += std::atan2(q[k].x() * q[k + 1].y() - q[k].y() * q[k + 1].x(), q[k].dot(q[k + 1]));
     d.swept_turns = turn / (2.0 * std::numbers::pi);
-    d.turn_fraction = std::fabs(d.swept_turns) / d.periods;
+    d.turn_fraction = d.periods > 0 ? std::fabs(d.swept_turns) / d.periods : 0.0;
+    if (!(double(c.size()) >= 2.0 * o.min_periods && d.periods >= o.min_periods)) {
+      d.mode = "undetermined";
+      return d;
+    }
   } else {
     d.swing_period = nan;
   }

@@ -239,7 +239,7 @@ parafsi_example_refuses(example_parachute_drop_slice_full parachute_drop "slice_
 parafsi_example_refuses(example_parachute_drop_out_not_a_directory parachute_drop "" "Not a directory"
   --resolution tiny --t-end 0.01 --quiet --out /dev/full/x)
 # Non-finite values of every floating flag, named by the flag.
-foreach(flag IN ITEMS t-end history-every box-width box-length box-ahead growth cell element cfl pfac stiffening
+foreach(flag IN ITEMS t-end history-every force-cutoff box-width box-length box-ahead growth cell element cfl pfac stiffening
                       coupling-damping membrane-damping initial-speed impedance payload-mass line-stiffness
                       modulus-scale packed-parameter fixed-fall pgs vtk-every checkpoint-every)
   parafsi_example_refuses(example_parachute_drop_nan_${flag} parachute_drop ""

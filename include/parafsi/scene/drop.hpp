@@ -92,8 +92,7 @@ struct drop_config {
   std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
   double t_end = 6.0;                 ///< simulated time (s)
   double history_every = 0.005;       ///< output interval (s)
-  double force_cutoff =
-      10.0;  ///< open-force filter cut-off (Hz): open_force_filtered, F_p, t_p (io/gaussian_filter.hpp)
+  double force_cutoff = 10.0;         ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
   double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
   double cfl = 0.9;   ///< CFL number of the fluid step

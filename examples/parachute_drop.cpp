@@ -20,7 +20,8 @@
 // following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
 // --payload-mass, --initial-speed (extreme scenes).
 //
-// Writes in DIR: history.csv (one row per --history-every ≤ 5 ms), summary.csv, and
+// Writes in DIR: history.csv (one row per --history-every ≤ 5 ms; its last column the
+// riser force low-pass filtered at --force-cutoff, 10 Hz), summary.csv, and
 // mid-plane slices slice_<t>.csv (+ slice_<t>_nodes.csv) at --slice-times. Definitions:
 // include/parafsi/io/drop_summary.hpp and docs/validation.md. Progress on stderr; the
 // summary row on stdout at the end.
@@ -109,6 +110,12 @@ int main(int argc, char** argv) {
   app.add_option("--history-every", c.history_every, "history.csv row interval (s), at most 5 ms")
       ->check(finite)
       ->check(CLI::Range(1e-5, 0.005))
+      ->capture_default_str();
+  app.add_option("--force-cutoff", c.force_cutoff,
+                 "cut-off (-3 dB, Hz) of the zero-phase low-pass filter of the riser force: history.csv "
+                 "open_force_filtered and the summary's F_p, t_p")
+      ->check(finite)
+      ->check(CLI::Range(0.5, 1000.0))
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--slice-times", [&c](const std::string& s) { c.slice_times = parse_list(s); },

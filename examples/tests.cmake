@@ -170,14 +170,14 @@ function(parafsi_example_dir_test name program csvs headers rows expect)
 endfunction()
 
 parafsi_example_dir_test(example_drop_guide drop_guide "history.csv|summary.csv"
-  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "11|1" "rows=11 t=0\\.0500 s" --t-end 0.05)
 parafsi_example_test(example_drop_guide_help drop_guide --help)
 parafsi_example_fails(example_drop_guide_bad_t_end drop_guide --t-end -1 --out ${_ex_out}/unused_drop_guide)
 
 # ---- parachute_drop: the tiny grid for 20 ms with pressure-gradient scaling; bad flags.
 parafsi_example_dir_test(example_parachute_drop_tiny_pgs parachute_drop "history.csv|summary.csv"
-  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --pgs 4 --slice-times 0.01 --quiet)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
@@ -239,7 +239,7 @@ parafsi_example_refuses(example_parachute_drop_slice_full parachute_drop "slice_
 parafsi_example_refuses(example_parachute_drop_out_not_a_directory parachute_drop "" "Not a directory"
   --resolution tiny --t-end 0.01 --quiet --out /dev/full/x)
 # Non-finite values of every floating flag, named by the flag.
-foreach(flag IN ITEMS t-end history-every box-width box-length box-ahead growth cell element cfl pfac stiffening
+foreach(flag IN ITEMS t-end history-every force-cutoff box-width box-length box-ahead growth cell element cfl pfac stiffening
                       coupling-damping membrane-damping initial-speed impedance payload-mass line-stiffness
                       modulus-scale packed-parameter fixed-fall pgs vtk-every checkpoint-every)
   parafsi_example_refuses(example_parachute_drop_nan_${flag} parachute_drop ""

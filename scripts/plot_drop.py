@@ -44,8 +44,13 @@ def plot_histories(runs, labels, out):
     os.makedirs(out, exist_ok=True)
     for col, ylabel, fname in HIST:
         fig, ax = plt.subplots(figsize=(6.4, 4.0))
+        filtered = col == "open_force" and all("open_force_filtered" in h.dtype.names for h in runs)
         for h, lab in zip(runs, labels):
-            ax.plot(h["t"], h[col], lw=1.2, label=lab)
+            if filtered:  # raw thin, the 10 Hz zero-phase filtered force thick
+                (raw,) = ax.plot(h["t"], h[col], lw=0.5, alpha=0.5)
+                ax.plot(h["t"], h["open_force_filtered"], lw=1.4, color=raw.get_color(), label=lab + " (filtered)")
+            else:
+                ax.plot(h["t"], h[col], lw=1.2, label=lab)
         ax.set_xlabel("t (s)")
         ax.set_ylabel(ylabel)
         if col == "drag_coefficient":
@@ -53,7 +58,7 @@ def plot_histories(runs, labels, out):
             ymax = max(np.nanpercentile(h[col][h["t"] > 1.0], 99) if np.any(h["t"] > 1.0) else 2.0 for h in runs)
             ax.set_ylim(0, max(1.5, 1.3 * ymax))
         ax.grid(alpha=0.3)
-        if len(runs) > 1 or col == "drag_coefficient":
+        if len(runs) > 1 or col == "drag_coefficient" or filtered:
             ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(os.path.join(out, fname), dpi=120)

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -105,8 +107,17 @@ TEST_CASE("summary of a vertical synthetic drop") {
   CHECK(s.t_f > 0.47);
   CHECK(s.t_f <= 0.5 + 1e-12);
   CHECK(s.t_mo == Approx(0.7).epsilon(1e-9));
+  CHECK(s.overshoot_diameter == Approx(0.8).epsilon(1e-9));
+  CHECK(s.t_max_diameter == Approx(0.7).epsilon(1e-9));
+  // Force pulse 5 + 40 e^{-((t-0.45)/0.05)^2}: a Gaussian of standard deviation
+  // s = 0.05/√2 = 35.4 ms. Raw maximum 45 N at 0.45 s; filtered at 10 Hz (σ = √ln2/(20π)
+  // = 13.25 ms) its peak stays at 0.45 s and falls to 5 + 40 s/√(s² + σ²) = 42.457 N
+  // (sampled kernel truncated at 4σ: 1e-4 relative).
+  CHECK(s.t_p_raw == Approx(0.45).epsilon(1e-9));
+  CHECK(s.F_p_raw == Approx(45.0).epsilon(1e-9));
+  const double sp = 0.05 / std::sqrt(2.0), sg = std::sqrt(std::log(2.0)) / (20 * std::numbers::pi);
   CHECK(s.t_p == Approx(0.45).epsilon(1e-9));
-  CHECK(s.F_p == Approx(45.0).epsilon(1e-9));
+  CHECK(s.F_p == Approx(5 + 40 * sp / std::sqrt(sp * sp + sg * sg)).epsilon(2e-4));
   // Mean speed over [4, 6] of 5 + 5 e^{-t}: 5 + 5 (e^{-4} − e^{-6})/2 (trapezoid rule error ~1e-6).
   CHECK(s.v_terminal == Approx(5 + 2.5 * (std::exp(-4.0) - std::exp(-6.0))).epsilon(1e-4));
   CHECK(s.cd_terminal == Approx(2 * 2 * 9.81 / (1.18 * 25 * std::numbers::pi / 4)).epsilon(0.02));
@@ -115,39 +126,300 @@ TEST_CASE("summary of a vertical synthetic drop") {
   CHECK(s.csv_row().rfind("mat544,", 0) == 0);
 }
 
-TEST_CASE("descent modes: gliding (steady drift and tilt) and coning (turning drift)") {
-  // Steady tilt 15° and 1.5 m/s horizontal drift one way: gliding.
-  const auto g = io::summarize(synthetic(6.0, 0.005, 0.7, 5.0, 15.0, 1.5), "x");
-  CHECK(g.attitude_amplitude == Approx(15.0).epsilon(1e-9));
-  CHECK(g.drift_speed == Approx(1.5).epsilon(1e-9));
-  CHECK(g.descent_mode == "gliding");
-  // Tilt swinging ±15° and the drift direction turning at 3 rad/s: coning.
-  const auto c = io::summarize(synthetic(6.0, 0.005, 0.7, 5.0, 15.0, 1.5, 3.0), "x");
-  CHECK(c.attitude_amplitude == Approx(15.0).epsilon(1e-3));
-  CHECK(c.horizontal_speed == Approx(1.5).epsilon(1e-9));
-  CHECK(c.drift_speed < 0.3);
-  CHECK(c.descent_mode == "coning");
-  // The rule itself.
-  CHECK(io::classify_descent(5.0, 0.0, 0.2, 5.0) == "vertical");
-  CHECK(io::classify_descent(5.0, 0.9, 1.0, 5.0) == "gliding");
-  CHECK(io::classify_descent(12.0, 0.1, 1.0, 5.0) == "coning");
-  CHECK(io::classify_descent(12.0, 0.0, 0.0, 5.0) == "coning");
+// ------------------------------------------------------------------ the force filter
+// io/gaussian_filter.hpp: σ = √ln2/(2π f_c); G(f) = exp(−2π²σ²f²) is 1/√2 at f_c.
+TEST_CASE("zero-phase filter: constants and lines pass unchanged, edges included; the cut-off is -3 dB") {
+  const io::gaussian_lowpass f(10.0, 0.005);
+  CHECK(f.sigma() == Approx(std::sqrt(std::log(2.0)) / (20 * std::numbers::pi)).epsilon(1e-14));
+  CHECK(f.half_window() == 11);  // ⌈4 · 13.25 ms / 5 ms⌉
+  CHECK(f.response(10.0) == Approx(1 / std::sqrt(2.0)).epsilon(1e-14));
+  const int n = 200;
+  std::vector<double> c(n, 3.7), line(n);
+  for (int i = 0; i < n; ++i) line[i] = -2.0 + 0.31 * i;
+  const auto yc = f.apply(c), yl = f.apply(line);
+  double ec = 0, el = 0;
+  for (int i = 0; i < n; ++i) {
+    ec = std::max(ec, std::fabs(yc[i] - c[i]));
+    el = std::max(el, std::fabs(yl[i] - line[i]));
+  }
+  CHECK(ec < 1e-13);  // 3.7 to round-off, first and last 11 samples included
+  CHECK(el < 1e-12);  // values up to 60: round-off
+  // Short series (shorter than the window) and a single sample.
+  std::vector<double> l5{1, 2, 3, 4, 5};
+  for (int i = 0; i < 5; ++i) CHECK(f.at(l5, std::size_t(i)) == Approx(l5[std::size_t(i)]).epsilon(1e-13));
+  CHECK(f.at(std::vector<double>{4.2}, 0) == 4.2);
+  // A sinusoid in the interior: amplitude G(f) (1/√2 at 10 Hz; 3.9e-3 at 40 Hz), no phase
+  // shift; to 2e-5 of the amplitude (the kernel truncated at 4σ).
+  for (double fr : {10.0, 40.0}) {
+    std::vector<double> x(n);
+    for (int i = 0; i < n; ++i) x[i] = std::cos(2 * std::numbers::pi * fr * 0.005 * i);
+    const auto y = f.apply(x);
+    for (int i = 60; i < 140; i += 7) CHECK(std::fabs(y[std::size_t(i)] - f.response(fr) * x[std::size_t(i)]) < 2e-5);
+  }
+  CHECK_THROWS_AS(io::gaussian_lowpass(0.0, 0.005), parafsi::invalid_input);
+  CHECK_THROWS_AS(io::gaussian_lowpass(10.0, std::nan("")), parafsi::invalid_input);
+}
+
+TEST_CASE("zero-phase filter: a smooth opening peak under ringing is recovered in value and time") {
+  // Smooth peak 30 N, standard deviation 60 ms (width at half height 0.14 s) at 1.0 s on
+  // 15 N, plus ±4 N ringing at 40 Hz and ±3 N at 27 Hz. The raw maximum is off by up to
+  // 7 N; the 10 Hz filter passes the peak times s/√(s² + σ²) = 0.9765 (29.30 N) and the
+  // ringing times G = 3.9e-3 and 0.080: the filtered peak is within 0.25 N (0.8 %) of
+  // 15 + 29.30 N and 5 ms (one sample) of 1.0 s, and within 3 % of the smooth peak 45 N.
+  std::vector<io::drop_history_row> h;
+  const double s = 0.06, A = 30;
+  for (int i = 0; i <= 600; ++i) {
+    io::drop_history_row r;
+    r.t = 0.005 * i;
+    r.open_force = 15 + A * std::exp(-std::pow(r.t - 1.0, 2) / (2 * s * s)) +
+                   4 * std::sin(2 * std::numbers::pi * 40 * r.t + 0.3) + 3 * std::sin(2 * std::numbers::pi * 27 * r.t);
+    r.canopy_diameter = 0.7;
+    h.push_back(r);
+  }
+  const auto sum = io::summarize(h, "ringing");
+  const double sg = std::sqrt(std::log(2.0)) / (20 * std::numbers::pi);
+  CHECK(sum.F_p_raw > 46.0);
+  CHECK(sum.F_p == Approx(15 + A * s / std::sqrt(s * s + sg * sg)).epsilon(0.25 / 44.3));
+  CHECK(sum.F_p == Approx(45.0).epsilon(0.03));
+  CHECK(std::fabs(sum.t_p - 1.0) <= 0.005 + 1e-12);
+
+  // The history column: filled row by row as the history grows (each window complete H
+  // rows later, the last H at the end) it equals the series filtered at once, bit for bit,
+  // and its maximum is the summary's F_p.
+  io::drop_history_filter filt(io::open_force_lowpass(h));
+  CHECK(filt.lowpass().half_window() == 11);
+  std::vector<io::drop_history_row> grow;
+  std::size_t written = 0;
+  for (const auto& r : h) {
+    grow.push_back(r);
+    const auto done = filt.complete(grow);
+    written += done.size();
+    CHECK(written + std::min<std::size_t>(grow.size(), 11) == grow.size());
+  }
+  written += filt.finish(grow).size();
+  CHECK(written == h.size());
+  std::vector<double> raw;
+  for (const auto& r : h) raw.push_back(r.open_force);
+  const auto whole = filt.lowpass().apply(raw);
+  std::size_t differing = 0;
+  double col_max = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    if (grow[i].open_force_filtered != whole[i]) ++differing;
+    col_max = std::max(col_max, grow[i].open_force_filtered);
+  }
+  CHECK(differing == 0);
+  CHECK(col_max == sum.F_p);
+}
+
+// ------------------------------------------------------------------ t_mo
+TEST_CASE("t_mo: the inflation overshoot, not a later, higher breathing peak") {
+  // D rises to D_s = 0.7 by 0.7 s, overshoots to 0.756 (+8 %) at 0.9 s, falls back below
+  // D_s, then breathes with peaks of 0.77 (+10 %) at 1.8 s and 0.763 at 2.8 s, steady from
+  // 4 s; a ±0.0014 (0.2 % D_s) 37 Hz wiggle rides on everything, below the 1 % band.
+  std::vector<io::drop_history_row> h;
+  for (int i = 0; i <= 1200; ++i) {
+    io::drop_history_row r;
+    r.t = 0.005 * i;
+    const double t = r.t;
+    double D = 0.2 + 0.5 * std::min(1.0, t / 0.7);
+    D += 0.056 * std::exp(-std::pow((t - 0.9) / 0.12, 2)) - 0.04 * std::exp(-std::pow((t - 1.3) / 0.15, 2));
+    D += 0.07 * std::exp(-std::pow((t - 1.8) / 0.15, 2)) + 0.063 * std::exp(-std::pow((t - 2.8) / 0.15, 2));
+    D += 0.0014 * std::sin(2 * std::numbers::pi * 37 * t);
+    r.canopy_diameter = D;
+    h.push_back(r);
+  }
+  const auto s = io::summarize(h, "breathing");
+  CHECK(s.steady_diameter == Approx(0.7).epsilon(1e-3));
+  CHECK(s.t_f < 0.7);
+  CHECK(std::fabs(s.t_mo - 0.9) <= 0.01 + 1e-12);  // the overshoot, to two samples
+  CHECK(s.overshoot_diameter == Approx(0.756).epsilon(3e-3));
+  CHECK(std::fabs(s.t_max_diameter - 1.8) <= 0.01 + 1e-12);  // the old definition: a breathing peak
+  CHECK(s.max_diameter == Approx(0.77).epsilon(3e-3));
+  // Without the overshoot the first maximum is the end of the rise: the plateau at D_s
+  // (0.7 to 0.9 s) that the dip towards 1.3 s falls back from.
+  for (auto& r : h) r.canopy_diameter -= 0.056 * std::exp(-std::pow((r.t - 0.9) / 0.12, 2));
+  const auto n = io::summarize(h);
+  CHECK(n.t_mo >= 0.7 - 1e-12);
+  CHECK(n.t_mo <= 0.9 + 1e-12);
+  CHECK(n.overshoot_diameter == Approx(0.7).epsilon(3e-3));
+}
+
+// ------------------------------------------------------------------ descent mode
+namespace {
+
+/// Deterministic noise in [−1, 1] (std::mt19937's output is fixed by the standard).
+struct noise {
+  std::mt19937 g{12345};
+  double operator()() { return 2.0 * double(g()) / 4294967295.0 - 1.0; }
+};
+
+/// A descent at v_T = 5 m/s with the canopy's tilt vector p(t) = (a_x, a_y)/a_z and the
+/// horizontal payload velocity v_h(t); constant diameter (so the mode window is all of it).
+template <class P, class V>
+std::vector<io::drop_history_row> descent(double t_end, P p, V vh) {
+  std::vector<io::drop_history_row> h;
+  for (int i = 0; 0.005 * i <= t_end + 1e-12; ++i) {
+    io::drop_history_row r;
+    r.t = 0.005 * i;
+    const Eigen::Vector2d q = p(r.t), v = vh(r.t);
+    r.canopy_phi_y = io::deg(std::atan(q.x()));
+    r.canopy_phi_x = -io::deg(std::atan(q.y()));
+    r.vx = v.x();
+    r.vy = v.y();
+    r.vz = -5.0;
+    r.speed = std::sqrt(v.squaredNorm() + 25.0);
+    r.canopy_diameter = 0.7;
+    h.push_back(r);
+  }
+  return h;
+}
+
+}  // namespace
+
+TEST_CASE("descent mode on synthetic histories: coning, planar, gliding, vertical, too short") {
+  const double a = std::tan(io::rad(15.0)), T = 2.5, w = 2 * std::numbers::pi / T;
+  // Tilt vector → angles → tilt vector is exact to round-off.
+  {
+    const auto h = descent(
+        0.0, [](double) { return Eigen::Vector2d(0.2, -0.1); }, [](double) { return Eigen::Vector2d(0, 0); });
+    CHECK(std::tan(io::rad(h[0].canopy_phi_y)) == Approx(0.2).epsilon(1e-14));
+  }
+  // Pure cone: the tilt vector turns one way at constant amplitude 15°, period 2.5 s, over
+  // 8 s = 3.2 periods; v_h turns with it (1.5 m/s).
+  const auto cone = descent(
+      8.0, [&](double t) { return Eigen::Vector2d(a * std::cos(w * t), a * std::sin(w * t)); },
+      [&](double t) { return Eigen::Vector2d(-1.5 * std::sin(w * t), 1.5 * std::cos(w * t)); });
+  const auto c = io::classify_descent(cone, 5.0);
+  CHECK(c.mode == "coning");
+  CHECK(c.swing_period == Approx(T).epsilon(0.01));
+  CHECK(c.periods == Approx(3.2).epsilon(0.01));
+  CHECK(c.swept_turns == Approx(3.2).epsilon(0.01));  // counter-clockwise seen from above: positive
+  CHECK(c.turn_fraction == Approx(1.0).epsilon(0.01));
+  CHECK(c.principal_ratio > 0.9);
+  CHECK(c.swing_amplitude == Approx(15.0).epsilon(0.03));  // 3.2 periods: the variance a little off a²/2
+  CHECK(c.drift_speed < 0.2 * c.horizontal_speed);
+  // The same through summarize: the mode window starts at t_f = 0 (constant diameter).
+  CHECK(io::summarize(cone, "cone").descent_mode == "coning");
+
+  // Planar pendulum along a line at 30° to x: amplitude 15°, v_h along the same line.
+  const Eigen::Vector2d u(std::cos(io::rad(30.0)), std::sin(io::rad(30.0)));
+  const auto plane = descent(
+      8.0, [&](double t) -> Eigen::Vector2d { return a * std::sin(w * t) * u; },
+      [&](double t) -> Eigen::Vector2d { return 1.5 * std::cos(w * t) * u; });
+  const auto p = io::classify_descent(plane, 5.0);
+  CHECK(p.mode == "planar");
+  CHECK(p.swing_period == Approx(T).epsilon(0.01));
+  CHECK(p.principal_ratio < 1e-12);
+  CHECK(std::fabs(p.swept_turns) < 0.05);
+  // A slightly elliptic swing (minor/major 0.1, turning one way) is still planar: its turn
+  // is made through the centre band.
+  const Eigen::Vector2d v(-u.y(), u.x());
+  const auto ell = descent(
+      8.0, [&](double t) -> Eigen::Vector2d { return a * (std::sin(w * t) * u + 0.1 * std::cos(w * t) * v); },
+      [&](double t) -> Eigen::Vector2d { return 1.5 * std::cos(w * t) * u; });
+  const auto pe = io::classify_descent(ell, 5.0);
+  CHECK(pe.mode == "planar");
+  CHECK(pe.turn_fraction < 0.5);
+
+  // Steady glide: constant 12° tilt, 1.2 m/s drift one way.
+  const auto glide = descent(
+      8.0, [](double) { return Eigen::Vector2d(std::tan(io::rad(12.0)), 0); },
+      [](double) { return Eigen::Vector2d(1.2, 0); });
+  const auto g = io::classify_descent(glide, 5.0);
+  CHECK(g.mode == "gliding");
+  CHECK(g.mean_tilt == Approx(12.0).epsilon(1e-9));
+  CHECK(g.swing_amplitude < 1e-6);
+  CHECK(std::isnan(g.swing_period));
+  CHECK(g.drift_speed == Approx(1.2).epsilon(1e-12));
+
+  // Vertical descent with noise: tilt ±4° and v_h ±0.3 m/s (< 0.1 v_T on average).
+  noise rnd;
+  const double n4 = std::tan(io::rad(4.0));
+  const auto vert = descent(
+      8.0, [&](double) { return Eigen::Vector2d(n4 * rnd(), n4 * rnd()); },
+      [&](double) { return Eigen::Vector2d(0.3 * rnd(), 0.3 * rnd()); });
+  const auto vv = io::classify_descent(vert, 5.0);
+  CHECK(vv.mode == "vertical");
+  CHECK(vv.peak_tilt < 10.0);
+
+  // Cone with noise: ±3° on each tilt component (a fifth of the amplitude) and ±0.3 m/s.
+  const double n3 = std::tan(io::rad(3.0));
+  const auto ncone = descent(
+      8.0,
+      [&](double t) { return Eigen::Vector2d(a * std::cos(w * t) + n3 * rnd(), a * std::sin(w * t) + n3 * rnd()); },
+      [&](double t) {
+    return Eigen::Vector2d(-1.5 * std::sin(w * t) + 0.3 * rnd(), 1.5 * std::cos(w * t) + 0.3 * rnd());
+      });
+  const auto nc = io::classify_descent(ncone, 5.0);
+  CHECK(nc.mode == "coning");
+  CHECK(nc.swing_period == Approx(T).epsilon(0.03));
+  CHECK(nc.turn_fraction > 0.8);
+  // Planar swing with the same noise.
+  const auto nplane = descent(
+      8.0,
+      [&](double t) -> Eigen::Vector2d { return a * std::sin(w * t) * u + Eigen::Vector2d(n3 * rnd(), n3 * rnd()); },
+      [&](double t) -> Eigen::Vector2d {
+        return 1.5 * std::cos(w * t) * u + Eigen::Vector2d(0.3 * rnd(), 0.3 * rnd());
+      });
+  const auto np = io::classify_descent(nplane, 5.0);
+  CHECK(np.mode == "planar");
+  CHECK(np.swing_period == Approx(T).epsilon(0.03));
+  CHECK(np.turn_fraction < 0.3);  // 0.15: the noise's turning
+
+  // Too short: the cone over 3 s and over 4.5 s (1.2 and 1.8 periods) is undetermined,
+  // its period still estimated (from 1.2 periods 10 % off: the principal direction of an
+  // incomplete circle is biased).
+  for (double len : {3.0, 4.5}) {
+    CAPTURE(len);
+    const auto sc = io::classify_descent(std::span(cone).first(std::size_t(len / 0.005) + 1), 5.0);
+    CHECK(sc.mode == "undetermined");
+    CHECK(sc.periods < 2.0);
+    CHECK(sc.swing_period == Approx(T).epsilon(0.15));  // from 1.2 periods: 10 % off
+  }
+  // Over 6 s (2.4 periods) it is determined.
+  const auto c6 = io::classify_descent(std::span(cone).first(1201), 5.0);
+  CHECK(c6.mode == "coning");
+  CHECK(c6.centre_crossings >= 4);
+  // A swing that starts late: 8 s of vertical descent, then the cone for 4 s (1.6 periods).
+  // The window (12 s) is long enough, but the swing is seen for less than two periods.
+  const auto late = descent(
+      12.0,
+      [&](double t) -> Eigen::Vector2d {
+        return t < 8.0 ? Eigen::Vector2d(0, 0)
+                       : Eigen::Vector2d(a * std::sin(w * (t - 8)), a * (1 - std::cos(w * (t - 8))));
+      },
+      [&](double t) -> Eigen::Vector2d { return t < 8.0 ? Eigen::Vector2d(0, 0) : Eigen::Vector2d(1.5, 0); });
+  const auto lt = io::classify_descent(late, 5.0);
+  CHECK(lt.mode == "undetermined");
+  CHECK(lt.centre_crossings < 4);
 }
 
 TEST_CASE("history rows round-trip and the headers are the contract's") {
   CHECK(std::string(io::drop_history_header) ==
         "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,"
-        "flight_path_angle,drag_coefficient");
+        "flight_path_angle,drag_coefficient,open_force_filtered");
   CHECK(std::string(io::drop_summary_header) ==
         "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode");
   io::drop_history_row r;
   r.t = 1.5;
   r.open_force = 12.5;
   r.drag_coefficient = 0.8;
+  r.open_force_filtered = 11.25;
   const auto back = io::drop_history_row::from(r.values());
   CHECK(back.t == 1.5);
   CHECK(back.open_force == 12.5);
   CHECK(back.drag_coefficient == 0.8);
+  CHECK(back.open_force_filtered == 11.25);
+  // A history of the earlier 16-column format is refused, naming both headers.
+  const std::string old_text = std::string(io::drop_history_header_16) + "\n0,0,0,35,0,0,0,0,0.2,0,0,0,0,0,90,nan\n";
+  CHECK_THROWS_WITH_AS(io::parse_drop_history(old_text, "old.csv", 1.0),
+                       doctest::Contains("'old.csv' line 1: header 't,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,"
+                                         "payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,"
+                                         "drag_coefficient' is the 16-column drop history of an earlier version, "
+                                         "without open_force_filtered; this version reads 't,x,y,z,vx,vy,vz,speed,"
+                                         "canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,"
+                                         "canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered'"),
+                       parafsi::invalid_input);
   // Empty and short histories.
   const auto e = io::summarize(std::span<const io::drop_history_row>{}, "none");
   CHECK(std::isnan(e.t_f));
@@ -211,7 +483,7 @@ TEST_CASE("history.csv: written through a checked file, read back bit for bit") 
                        parafsi::invalid_input);
   corrupt("short.csv", 4, "0.01,1,2");
   CHECK_THROWS_WITH_AS(io::read_drop_history(dir / "short.csv", 1.0),
-                       doctest::Contains("short.csv' line 4: 3 columns, expected 16"), parafsi::invalid_input);
+                       doctest::Contains("short.csv' line 4: 3 columns, expected 17"), parafsi::invalid_input);
   corrupt("header.csv", 1, "t,x,y");
   CHECK_THROWS_WITH_AS(io::read_drop_history(dir / "header.csv", 1.0), doctest::Contains("header.csv' line 1: header"),
                        parafsi::invalid_input);

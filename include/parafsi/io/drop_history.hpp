@@ -7,9 +7,13 @@
 ///
 ///   io::drop_observer observe(scene);                          // model::drop_scene
 ///   io::drop_history_writer hist(dir / "history.csv");         // header written
-///   hist.write(observe(s.time(), s.structure()));              // a row, flushed
+///   io::drop_history_filter filt(io::gaussian_lowpass(10.0, 0.005));  // open_force_filtered
+///   rows.push_back(observe(s.time(), s.structure()));
+///   for (const auto& r : filt.complete(rows)) hist.append(r);  // the rows whose window is complete
+///   hist.flush();
+///   for (const auto& r : filt.finish(rows)) hist.append(r);    // at the end: the last H rows
 ///   hist.close();
-///   io::write_drop_summary(dir / "summary.csv", io::summarize(rows, fabric));
+///   io::write_drop_summary(dir / "summary.csv", io::summarize(rows, fabric, options));
 ///   auto kept = io::read_drop_history(dir / "history.csv", t_restart);  // rows with t <= t_restart
 ///
 /// Observer: payload mass centre and velocity from the payload body; canopy diameter from
@@ -20,11 +24,16 @@
 /// `scene.total_mass() · g` and S0 = π D0²/4. A non-finite structure node is a
 /// `numerical_failure` naming the node and the time.
 ///
-/// Reading (restart): the header must be `drop_history_header`; every complete line must
-/// hold 16 numbers (`nan` allowed); a bad number is an error naming the file, the line,
-/// the column and the text. A last line without its line break (a run killed while
-/// writing it) is ignored; a missing file gives no rows.
-/// io/ is never included by physics headers.
+/// Writing: a row goes to the file once its open_force_filtered is known, H rows (the
+/// filter's half-window, 11 rows = 55 ms at the defaults) after its own time; the last H
+/// rows at the end of the run. A run killed by a signal leaves history.csv without its
+/// last H rows (a run stopped by an error writes them, with the end-of-run edge rule).
+///
+/// Reading (restart): the header must be `drop_history_header`; the 16-column header of
+/// the earlier format (`drop_history_header_16`, without open_force_filtered) is refused
+/// naming both; every complete line must hold 17 numbers (`nan` allowed); a bad number is an error naming the file, the
+/// line, the column and the text. A last line without its line break (a run killed while writing it) is ignored; a
+/// missing file gives no rows. io/ is never included by physics headers.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -139,6 +148,7 @@ class drop_history_writer {
     append(r);
     f_.flush();
   }
+  void flush() { f_.flush(); }
   void close() { f_.close(); }
 
  private:
@@ -171,7 +181,8 @@ inline std::vector<drop_history_row> parse_drop_history(std::string_view text, c
                                                                             "canopy_phi_x",
                                                                             "canopy_phi_y",
                                                                             "flight_path_angle",
-                                                                            "drag_coefficient"};
+                                                                            "drag_coefficient",
+                                                                            "open_force_filtered"};
   std::size_t pos = 0;
   long line_no = 0;
   while (pos < text.size()) {
@@ -182,6 +193,10 @@ inline std::vector<drop_history_row> parse_drop_history(std::string_view text, c
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_no == 1) {
+      require(line != drop_history_header_16, "io::read_drop_history: '", source, "' line 1: header '", line,
+              "' is the 16-column drop history of an earlier version, without open_force_filtered; this version "
+              "reads '",
+              drop_history_header, "' (rerun the drop, or restart from a checkpoint written by this version)");
       require(line == drop_history_header, "io::read_drop_history: '", source, "' line 1: header '", line,
               "' is not the drop history's ('", drop_history_header, "')");
       continue;

@@ -34,12 +34,17 @@
 /// uninterrupted one); the coupled step (the stepper moves the box after the payload:
 /// its frame target, `drop_frame_target`). At each output
 /// instant: a history row (checked for non-finite nodes), the αM guard (a warning once
-/// when α |v_payload| / c > 0.3), VTK and checkpoint at their intervals, the slices due.
+/// when α |v_payload| / c > 0.3), the rows whose open-force filter window is now complete
+/// to history.csv (io::drop_history_filter: a row is written H = ⌈4σ/history_every⌉ rows
+/// after its own, 11 rows at the defaults; the last H at the end of the run, or when the
+/// run stops with an error), VTK and checkpoint at their intervals, the slices due.
 /// Stops with numerical_failure when the stable step collapses below 1e-9 history_every
 /// or when the payload leaves a fixed box's refined column. Restart: the stepper's state
 /// from the checkpoint (refused if its air is not at this run's ambient, i.e. another α or
 /// scene pressure, or if t_end is not after its time), the history rows up to the
-/// restored time from the checkpoint (its section "history"). A checkpoint holds the
+/// restored time from the checkpoint (its section "history"), their filtered force
+/// recomputed from the raw column as their windows complete, so the restarted history.csv
+/// and summary.csv equal the uninterrupted run's bit for bit. A checkpoint holds the
 /// run's drop_signature: a restart whose parameters differ is refused naming the
 /// parameter and both values.
 /// Messages (progress is the caller's, through `progress`) go to stderr unless `quiet`.
@@ -87,6 +92,7 @@ struct drop_config {
   std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
   double t_end = 6.0;                 ///< simulated time (s)
   double history_every = 0.005;       ///< output interval (s)
+  double force_cutoff = 10.0;         ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
   double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
   double cfl = 0.9;   ///< CFL number of the fluid step
@@ -127,6 +133,7 @@ struct drop_config {
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
+                                                      {"force_cutoff", force_cutoff},
                                                       {"box_width", box_width},
                                                       {"box_length", box_length},
                                                       {"box_ahead", box_ahead},
@@ -154,6 +161,11 @@ struct drop_config {
       require(std::isfinite(t) && t >= 0, "parachute_drop: slice times must be finite and >= 0, got ", t);
     require(t_end > 0, "parachute_drop: t_end must be > 0 s, got ", t_end);
     require(history_every > 0, "parachute_drop: history_every must be > 0 s, got ", history_every);
+    // Below 0.5 Hz the filter (σ > 0.26 s) would flatten the opening peak (0.1–0.3 s) itself.
+    require(force_cutoff >= 0.5, "parachute_drop: --force-cutoff must be >= 0.5 Hz, got ", force_cutoff);
+    require(4.0 * std::sqrt(std::numbers::ln2) / (2.0 * std::numbers::pi * force_cutoff) / history_every <= 1e6,
+            "parachute_drop: --force-cutoff ", force_cutoff, " Hz at --history-every ", history_every,
+            " s needs a filter half-window of more than 1e6 rows");
     require(t_end / history_every <= 1e9, "parachute_drop: t_end / history_every = ", t_end / history_every,
             " output instants, more than 1e9");
     require(cfl > 0 && cfl <= 1, "parachute_drop: cfl must be in (0, 1], got ", cfl);
@@ -274,8 +286,8 @@ inline drop_setup make_drop_setup(const drop_config& c) {
 /// checkpoint and compared on restart (io::scene_signature), so a restart with another
 /// scene, resolution, coupling, α, payload, moduli, packed shape, box, closure, CFL,
 /// damping or output interval is refused naming the parameter and both values. Not in it:
-/// t_end, out, slice_times, vtk_every, checkpoint_every, threads (they do not change the
-/// computed states).
+/// t_end, out, slice_times, vtk_every, checkpoint_every, threads, force_cutoff (they do not
+/// change the computed states; the filtered force is recomputed from the raw one).
 inline io::scene_signature drop_signature(const drop_config& c, const drop_setup& su) {
   io::scene_signature g;
   g.add("canopy", c.canopy).add("fabric", std::string(su.scene.fabric.name)).add("resolution", c.resolution);
@@ -310,6 +322,7 @@ class drop_run {
         p_offset_(pgs_.pressure_offset(su.params.air_pressure)),
         c_air_(gas::ideal{}.sound_speed(su.params.air_density, su.params.air_pressure)),
         files_(!c.out.empty()),
+        filter_(io::gaussian_lowpass(c.force_cutoff, c.history_every)),
         signature_(drop_signature(c, su)) {}
   drop_run(const drop_run&) = delete;
   drop_run& operator=(const drop_run&) = delete;
@@ -319,7 +332,8 @@ class drop_run {
     const auto& nd = s_.structure().node_set();
     history_ = &res.history;
     if (!c_.restart.empty()) res.history = restart();
-    open_outputs(res.history);
+    open_outputs();
+    emit(false);  // carried rows: those whose filter window is complete
     const auto& g = s_.fluid().grid();
     res.cells = long(g.n(0)) * g.n(1) * g.n(2);
     res.nodes = long(nd.size());
@@ -332,9 +346,66 @@ class drop_run {
                    su_.params.name.c_str(), res.fabric.c_str(), c_.resolution.c_str(), res.cells, long(g.n(0)),
                    long(g.n(1)), long(g.n(2)), su_.box.cell, res.nodes, su_.scene.triangles.size(), c_.coupling.c_str(),
                    c_.box.c_str(), su_.alpha, c_.t_end);
-    if (c_.restart.empty()) record(res.history);
-    write_outputs();
     const auto t0 = std::chrono::steady_clock::now();
+    long substeps = 0;
+    try {
+      substeps = loop(res.history, progress);
+    } catch (...) {
+      // Stopped by an error: the rows still waiting for their filter window, with the
+      // end-of-run rule, so history.csv holds every row computed.
+      try {
+        emit(true);
+      } catch (...) {
+      }
+      throw;
+    }
+    emit(true);
+    if (hist_) hist_->close();
+    res.steps = s_.steps();
+    res.substeps_per_step = double(substeps) / double(std::max(1L, s_.steps()));
+    res.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.times = s_.timings();
+    if (!c_.quiet)
+      std::fprintf(stderr,
+                   "parachute_drop: %ld fluid steps, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
+                   "exchange %.1f, structure %.1f, fluid %.1f)\n",
+                   res.steps, res.substeps_per_step, res.wall, res.times.move_frame, res.times.exchange,
+                   res.times.structure, res.times.fluid);
+    io::summary_options so;
+    so.force_cutoff = c_.force_cutoff;
+    so.sample_interval = c_.history_every;
+    res.summary = io::summarize(res.history, res.fabric, so);
+    if (!c_.quiet) report(res.summary);
+    if (files_) io::write_drop_summary(out() / "summary.csv", res.summary);
+    return res;
+  }
+
+ private:
+  std::filesystem::path out() const { return std::filesystem::path(c_.out); }
+
+  /// The read-out behind the summary row, on stderr: raw and filtered peak force, the
+  /// overshoot and the largest diameter, the numbers of the descent mode.
+  void report(const io::drop_summary& m) const {
+    const auto& d = m.descent;
+    std::fprintf(stderr,
+                 "parachute_drop: F_p %.4g N at %.4g s (filtered at %g Hz; raw maximum %.4g N at %.4g s); t_mo %.4g s "
+                 "(D %.4g m; largest D %.4g m at %.4g s)\n",
+                 m.F_p, m.t_p, c_.force_cutoff, m.F_p_raw, m.t_p_raw, m.t_mo, m.overshoot_diameter, m.max_diameter,
+                 m.t_max_diameter);
+    std::fprintf(stderr,
+                 "parachute_drop: descent %s over [%.4g, %.4g] s: peak tilt %.3g deg, swing amplitude %.3g deg, "
+                 "period %.4g s (%.3g periods, %ld centre crossings; a mode needs 2 periods and 4 crossings), swept "
+                 "turns %.3g, minor/major variance %.3g, drift %.3g of mean |v_h| %.3g m/s\n",
+                 d.mode.c_str(), d.t_start, d.t_start + d.duration, d.peak_tilt, d.swing_amplitude, d.swing_period,
+                 d.periods, d.centre_crossings, d.swept_turns, d.principal_ratio,
+                 d.horizontal_speed > 0 ? d.drift_speed / d.horizontal_speed : 0.0, d.horizontal_speed);
+  }
+
+  /// The time loop from the start (its first row) or the restored state to t_end; returns
+  /// the structure substeps taken.
+  long loop(std::vector<io::drop_history_row>& history, const drop_progress& progress) {
+    if (c_.restart.empty()) record(history);
+    write_outputs();
     // Output times are n·history_every with an integer n (not a running sum), so a run
     // restarted from a checkpoint picks exactly the steps of the uninterrupted run.
     long n_out = long(std::floor(s_.time() / c_.history_every + 1e-6)) + 1;
@@ -353,7 +424,7 @@ class drop_run {
       s_.step(dt);
       substeps += s_.last_substeps();
       if (s_.time() >= next_out - 1e-9 * c_.history_every || s_.time() >= c_.t_end - 1e-12) {
-        record(res.history);
+        record(history);
         write_outputs();
         next_out = c_.history_every * double(++n_out);
         while (files_ && next_slice < slices.size() && s_.time() >= slices[next_slice] - 1e-9)
@@ -362,24 +433,8 @@ class drop_run {
       if (progress) progress(s_.time(), s_.steps(), false);
     }
     if (progress) progress(s_.time(), s_.steps(), true);
-    if (hist_) hist_->close();
-    res.steps = s_.steps();
-    res.substeps_per_step = double(substeps) / double(std::max(1L, s_.steps()));
-    res.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    res.times = s_.timings();
-    if (!c_.quiet)
-      std::fprintf(stderr,
-                   "parachute_drop: %ld fluid steps, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
-                   "exchange %.1f, structure %.1f, fluid %.1f)\n",
-                   res.steps, res.substeps_per_step, res.wall, res.times.move_frame, res.times.exchange,
-                   res.times.structure, res.times.fluid);
-    res.summary = io::summarize(res.history, res.fabric);
-    if (files_) io::write_drop_summary(out() / "summary.csv", res.summary);
-    return res;
+    return substeps;
   }
-
- private:
-  std::filesystem::path out() const { return std::filesystem::path(c_.out); }
 
   /// The stepper's state from the checkpoint (its scene signature compared first); the
   /// history rows up to its time, from the checkpoint.
@@ -405,11 +460,10 @@ class drop_run {
     return std::move(previous.rows);
   }
 
-  /// history.csv with the rows carried over; the VTK series.
-  void open_outputs(const std::vector<io::drop_history_row>& previous) {
+  /// history.csv (its header; the rows follow through `emit`); the VTK series.
+  void open_outputs() {
     if (!files_) return;
     hist_.emplace(out() / "history.csv");
-    for (const auto& r : previous) hist_->append(r);
     if (c_.vtk_every > 0) {
       std::filesystem::create_directories(out() / "vtk");
       pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
@@ -430,7 +484,16 @@ class drop_run {
                    "PGS alpha %g: compressibility errors grow as (alpha M)^2; use --pgs %.0f or lower for this speed\n",
                    r.t, r.speed, alpha * r.speed / c_air_, alpha, std::max(1.0, std::floor(0.2 * c_air_ / r.speed)));
     }
-    if (hist_) hist_->write(r);
+    emit(false);
+  }
+
+  /// The rows whose open-force filter window is complete (every row left when `end`):
+  /// their open_force_filtered filled, written to history.csv and flushed.
+  void emit(bool end) {
+    const auto rows = end ? filter_.finish(*history_) : filter_.complete(*history_);
+    if (!hist_ || rows.empty()) return;
+    for (const auto& r : rows) hist_->append(r);
+    hist_->flush();
   }
 
   /// VTK files and the checkpoint when their instants are reached.
@@ -489,12 +552,13 @@ class drop_run {
   fluid::pressure_gradient_scaling pgs_;
   double p_offset_, c_air_;
   bool files_;
+  io::drop_history_filter filter_;
   std::optional<io::drop_history_writer> hist_;
   std::optional<io::pvd_writer> pvd_;
   double next_vtk_ = 0, next_ckpt_ = 0;
   bool warned_mach_ = false;
   io::scene_signature signature_;
-  const std::vector<io::drop_history_row>* history_ = nullptr;  ///< the rows so far, saved with a checkpoint
+  std::vector<io::drop_history_row>* history_ = nullptr;  ///< the rows so far, saved with a checkpoint
 };
 
 /// f(viscosity, frame) for the setup's choices (resolved once: everything below is

@@ -18,12 +18,19 @@
 // Leer, SSP-RK2. Inviscid by default (separation fixed by the sharp edge); --reynolds RE
 // switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer
 // on the body is not resolved by either coupling).
-// The penalty coupling uses PFAC = 1 (as the other examples), impermeable.
+// The penalty coupling uses PFAC = 1 (as the other examples).
+//
+// Porous bodies: `--fabric mat544|mat59225|mat509` gives the body that fabric's Ergun law
+// (the paper's Table 2), `--porous-resistance K` the quadratic loss law of a screen,
+// Δp = K ½ρ u_n|u_n| (Ergun with α = 0, β t = K ρ / 2), u_n the through-velocity normal to
+// the cloth. Then `through_fraction=` is also printed: the mean through-velocity over the
+// body (the coupling's through-flow / its area) over U, averaged like the drag.
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
 #include <parafsi/model/disk_mesh.hpp>
+#include <parafsi/model/fabric_catalogue.hpp>
 
 #include <numbers>
 
@@ -33,8 +40,8 @@ namespace st = pf::structure;
 int main(int argc, char** argv) {
   CLI::App app{"Drag of a fixed disk or hemispherical cup in a uniform stream (penalty or embedded coupling)"};
   examples::common_options co;
-  std::string shape = "disk", coupling = "embedded", out;
-  double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0;
+  std::string shape = "disk", coupling = "embedded", out, fabric = "none";
+  double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0;
   int cells = 8;
   examples::add_run_options(app, co);
   app.add_option("--shape", shape, "disk (flat, normal to the stream) or cup (hemisphere, open towards the stream)")
@@ -54,6 +61,15 @@ int main(int argc, char** argv) {
     return "Reynolds number " + s + " is neither 0 (inviscid) nor in [1, 1e9]";
           },
           "0 or [1 - 1e9]"))
+      ->capture_default_str();
+  auto* fab_opt = app.add_option("--fabric", fabric, "porous body: the Ergun law of this fabric (none: impermeable)")
+                      ->check(CLI::IsMember({"none", "mat544", "mat59225", "mat509"}))
+                      ->capture_default_str();
+  app.add_option("--porous-resistance", resistance,
+                 "porous body with the loss law dp = K rho u_n|u_n| / 2 of this K (0: impermeable)")
+      ->check(examples::finite)
+      ->check(CLI::Range(0.0, 1e6))
+      ->excludes(fab_opt)
       ->capture_default_str();
   app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")
       ->check(CLI::Range(1e-4, 1e3))
@@ -112,7 +128,7 @@ int main(int argc, char** argv) {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
         examples::csv_writer csv(out, "t,drag_coefficient");
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
-        double sum = 0, sum_t = 0, max_pen = 0;
+        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0;
         examples::step_guard guard("bluff_body_drag", t_end);
         while (s.time() < t_end * (1.0 - 1e-12)) {
           double dt = guard(s.stable_dt(co.cfl), s.time());
@@ -130,6 +146,8 @@ int main(int argc, char** argv) {
           if (w > 0) {
             sum += cd * w;
             sum_t += w;
+            if constexpr (decltype(cpl)::porosity_type::permeable)
+              sum_q += s.coupling().total_through_flow() / s.coupling().coupled_area() / U * w;
           }
           prog(s.time(), s.steps());
         }
@@ -138,14 +156,28 @@ int main(int argc, char** argv) {
         const double cd = sum_t > 0 ? sum / sum_t : 0.0;
         std::printf(
             "drag_coefficient=%.6g shape=%s coupling=%s cells_per_diameter=%d averaged_from_t=%.6g t_end=%.6g "
-            "steps=%ld max_penetration_over_h=%.3g wall_seconds=%.1f\n",
+            "steps=%ld max_penetration_over_h=%.3g wall_seconds=%.1f",
             cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
+        if constexpr (decltype(cpl)::porosity_type::permeable)
+          std::printf(" through_fraction=%.6g", sum_t > 0 ? sum_q / sum_t : 0.0);
+        std::printf("\n");
         return 0;
       };
-      if (coupling == "embedded") return run(pf::coupling::embedded{pf::porosity::impermeable{}});
-      pf::coupling::penalty_options po;
-      po.pfac = pfac;
-      return run(pf::coupling::penalty{pf::porosity::impermeable{}, po});
+      auto with = [&](auto por) -> int {
+        if (coupling == "embedded") return run(pf::coupling::embedded{por});
+        pf::coupling::penalty_options po;
+        po.pfac = pfac;
+        return run(pf::coupling::penalty{por, po});
+      };
+      if (fabric != "none") {
+        const auto& fab = pf::model::fabric(fabric);
+        return with(pf::porosity::ergun{fab.alpha, fab.beta, fab.thickness});
+      }
+      if (resistance > 0) {
+        const double t = 1e-4;  // any thickness: the law is K ρ u²/2 whatever it is
+        return with(pf::porosity::ergun{0.0, resistance * rho / (2.0 * t), t});
+      }
+      return with(pf::porosity::impermeable{});
     };
     if (Re > 0) {
       const double mu = rho * U * D / Re;

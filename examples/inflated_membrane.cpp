@@ -2,7 +2,7 @@
 // damped explicit dynamics; the check is the Föppl–Hencky solution
 // (include/parafsi/structure/reference/hencky.hpp).
 //
-//   inflated_membrane --radius 0.5 --thickness 1e-4 --E 1e9 --nu 0.3 --pressure 20 \
+//   inflated_membrane --radius 0.5 --thickness 1e-4 --E 1e9 --nu 0.3 --pressure 20
 //                     --elements 20 --out membrane.csv [--element tri|quad]
 //
 // Prints `centre_deflection=<m>` (and Hencky's value for comparison) on stdout, writes

@@ -14,7 +14,7 @@ using pft::prim;
 TEST_CASE("free-stream preservation on a translating and rotating box") {
   const double rho0 = 1.18, p0 = 101325.0;
   const double c0 = std::sqrt(1.4 * p0 / rho0);
-  for (const Eigen::Vector3d u0 : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(3.0, -4.0, 12.0)}) {
+  for (const Eigen::Vector3d& u0 : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(3.0, -4.0, 12.0)}) {
     frame::rigid motion{Eigen::Vector3d(12.0, 16.0, 0.0), Eigen::Vector3d(0.6, 0.0, 0.8)};  // 20 m/s, 1 rad/s
     fluid::solver s{fluid::rectilinear_grid::uniform({10, 8, 6}, {-1, -1, -1}, {1, 1, 1}),
                     boundary::set::all(boundary::far_field{rho0, {u0[0], u0[1], u0[2]}, p0}), motion,

@@ -294,8 +294,8 @@ TEST_CASE("checkpoint: a penalty-coupled stepper restored mid-way continues bit-
   const auto& sb = again.structure().node_set().data();
   for (std::size_t f = 0; f < 6; ++f)
     CHECK(same_bits(sa.data(f), sb.data(f), std::size_t(ref.structure().node_set().size())));
-  for (std::size_t c = 0; c < ref.coupling().points().size(); ++c)
-    CHECK(ref.coupling().penetration(index_t(c)) == again.coupling().penetration(index_t(c)));
+  for (index_t c = 0; c < index_t(ref.coupling().points().size()); ++c)
+    CHECK(ref.coupling().penetration(c) == again.coupling().penetration(c));
   CHECK(ref.coupling().diagnostics().coupling_energy == again.coupling().diagnostics().coupling_energy);
   // The coupling's settings are part of the scene: another PFAC is refused by name.
   auto stiffer = make(2.0);

@@ -194,13 +194,7 @@ std::vector<double> reflected_pulse(int N) {
                                   f.primitive(i, 1, 1).p);
   };
   if constexpr (membrane) {
-    st::nodes nd;
-    for (const auto& x : d.sheet.positions) nd.add(x);
-    for (pf::index_t i = 0; i < nd.size(); ++i) nd.pin(i);
-    st::membrane_tri mem{ctu::sheet_mesh(d), st::material::fabric<>::isotropic(3e8, 0.3, 0.054, 1.1e-4)};
-    st::assembly as{std::move(nd), std::move(mem)};
-    as.integrator().gravity = {0, 0, 0};
-    pf::explicit_stepper s{std::move(fl), std::move(as), Coupling{pf::porosity::impermeable{}}};
+    pf::explicit_stepper s{std::move(fl), ctu::pinned_sheet(d), Coupling{pf::porosity::impermeable{}}};
     while (s.time() < t_end - 1e-15) s.step(std::min(s.stable_dt(0.4), t_end - s.time()));
     collect(s.fluid());
   } else {

@@ -38,13 +38,7 @@ auto make_duct(Coupling cpl, const pf::boundary::set& bc, int cells, double u0, 
   const auto d = pf::model::duct_screen(1.0, cells, xs, 2, incline_deg, width_cells);
   pf::fluid::solver fl{ctu::duct_grid(d), bc, flux};
   fl.fill_uniform({rho0, {u0, 0, 0}, p0});
-  st::nodes nd;
-  for (const auto& x : d.sheet.positions) nd.add(x);
-  for (pf::index_t i = 0; i < nd.size(); ++i) nd.pin(i);
-  st::membrane_tri mem{ctu::sheet_mesh(d), st::material::fabric<>::isotropic(3e8, 0.3, 0.054, 1.1e-4)};
-  st::assembly as{std::move(nd), std::move(mem)};
-  as.integrator().gravity = {0, 0, 0};
-  return pf::explicit_stepper{std::move(fl), std::move(as), std::move(cpl)};
+  return pf::explicit_stepper{std::move(fl), ctu::pinned_sheet(d), std::move(cpl)};
 }
 
 pf::boundary::set duct_bc(double V) {

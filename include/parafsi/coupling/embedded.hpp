@@ -14,9 +14,9 @@
 /// Crossings of one face at the same z (a segment through a shared edge or vertex)
 /// count once. Elements marked open (vents) are skipped.
 ///
-/// Face flux (per unit area; n the face normal, low → high; states L, R on each side, the
-/// cells' own or one-sided reconstructed (OneSided); w = n·v_s the membrane's normal velocity at the crossing, the
-/// mean over the layers; w_g the grid's normal speed). Unknown: the through-velocity
+/// Face flux (per unit area; n the face normal, low → high; states L, R on each side: the
+/// cells' own, or one-sided reconstructed with OneSided; w = n·v_s the membrane's normal
+/// velocity at the crossing, the mean over the layers; w_g the grid's normal speed). Unknown: the through-velocity
 /// u_p of the air relative to the membrane; the air at the membrane moves at
 /// u_m = w + u_p. Each side sees a piston moving at u_m: its wall pressure p*_K comes
 /// from the exact one-sided Riemann problem (Toro §4.2: rarefaction or shock branch,
@@ -135,7 +135,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   static constexpr bool fluid_first = true;
   /// With OneSided, the cells beside a membrane face are reconstructed from their own side
   /// only (fluid/detail/patch_faces.hpp) and the face states L, R are second order; without
-  /// it, L and R are the sweeps' two-sided values (their slopes read across the membrane).
+  /// it, the membrane Riemann problem takes the two cells' own states (first order).
   static constexpr bool one_sided_reconstruction = OneSided;
   static constexpr const char* name() noexcept { return "embedded"; }
   using base::base;
@@ -367,24 +367,12 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
 
   /// The membrane Riemann problem of one face: through-velocity u_p (relative to the
   /// membrane, along the face normal) and the two wall pressures, given the normal
-  /// velocities of the cell states, the membrane's normal velocity w and k layers
-  /// normal to the face (Δp = k Δp_por(u_p)).
+  /// velocities of the cell states, the membrane's normal velocity w and k layers.
   struct face_solution {
     double up = 0, psL = 0, rsL = 0, psR = 0, rsR = 0;
   };
   face_solution solve_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
                            int layers) const {
-    return solve_face_law(rL, unL, pL, rR, unR, pR, w, [&](double up) {
-      if constexpr (Porosity::permeable) return double(layers) * por_.pressure_jump(up);
-      else return 0.0;
-    });
-  }
-
- private:
-  /// The root of p*_L(w + u_p) − p*_R(w + u_p) = jump(u_p), jump rising in u_p.
-  template <class Jump>
-  face_solution solve_face_law(double rL, double unL, double pL, double rR, double unR, double pR, double w,
-                               Jump&& jump) const {
     face_solution s;
     auto eval = [&](double up, face_solution& o) {
       const double um = w + up;
@@ -392,7 +380,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
       wall_state(rR, pR, gamma_, um - unR, o.psR, o.rsR);
       o.up = up;
       double g = o.psL - o.psR;
-      if constexpr (Porosity::permeable) g -= jump(up);
+      if constexpr (Porosity::permeable) g -= double(layers) * por_.pressure_jump(up);
       return g;
     };
     const double g0 = eval(0.0, s);
@@ -441,6 +429,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     }
   }
 
+ private:
   struct crossing {
     index_t elem;
     std::array<double, 3> lambda;  ///< barycentric weights of the crossing point

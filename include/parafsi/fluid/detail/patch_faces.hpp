@@ -36,6 +36,26 @@ constexpr bool wants_one_sided() {
   else return false;
 }
 
+/// Two-sided face values of `cell` along D (what the sweeps used).
+template <int D, class Flux, class Recon>
+void sweep_cell_faces(const face_kernel<Flux, Recon>& fk, index_t cell, index_t ia, double* lo, double* hi) {
+  double* pl[5] = {&lo[0], &lo[1], &lo[2], &lo[3], &lo[4]};
+  double* ph[5] = {&hi[0], &hi[1], &hi[2], &hi[3], &hi[4]};
+  fk.template cell_faces<D, double>(cell, fk.grid.stride(D), ia, pl, ph, 0);
+}
+
+/// Centre (box coordinates) of the face between cells high − stride(d) and high.
+inline Eigen::Vector3d face_centre(const rectilinear_grid& grid, int d, index_t high) {
+  const auto ijk = grid.ijk(high);
+  Eigen::Vector3d x(grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2]));
+  x[d] = grid.face(d, ijk[std::size_t(d)]);
+  return x;
+}
+/// The grid's speed along axis d at box point x (the face's normal speed w_n).
+inline double face_speed(const stage_geometry& geo, int d, const Eigen::Vector3d& x) {
+  return geo.vh[d] + geo.oh.cross(x)[d];
+}
+
 /// Face values of `cell` along D (flat index, index ia along D): the two-sided MUSCL
 /// values where neither face along D is blocked (bit 2D: low face, 2D + 1: high face of
 /// `blocked`), else the one-sided values of the file comment.
@@ -46,9 +66,7 @@ void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<st
   const std::uint8_t lo_bit = std::uint8_t(1u << (2 * D)), hi_bit = std::uint8_t(1u << (2 * D + 1));
   const bool lo_b = blocked[std::size_t(cell)] & lo_bit, hi_b = blocked[std::size_t(cell)] & hi_bit;
   if (!lo_b && !hi_b) {
-    double* pl[5] = {&lo[0], &lo[1], &lo[2], &lo[3], &lo[4]};
-    double* ph[5] = {&hi[0], &hi[1], &hi[2], &hi[3], &hi[4]};
-    fk.template cell_faces<D, double>(cell, s, ia, pl, ph, 0);
+    sweep_cell_faces<D>(fk, cell, ia, lo, hi);
     return;
   }
   double q[5];
@@ -62,7 +80,6 @@ void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<st
       const bool far_blocked = blocked[std::size_t(cell + o)] & (hi_b ? lo_bit : hi_bit);
       const double ia_near = hi_b ? idc[ia] : idc[ia + 1], ia_far = hi_b ? idc[ia - 1] : idc[ia + 2];
       const double sg = hi_b ? 1.0 : -1.0;  // differences taken low → high
-      bool bad = false;
       double l[5], r[5];
       for (int f = 0; f < 5; ++f) {
         const double* w = fk.W[f];
@@ -72,7 +89,7 @@ void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<st
         l[f] = q[f] - d;
         r[f] = q[f] + d;
       }
-      bad = l[0] <= 0.0 || r[0] <= 0.0 || l[4] <= 0.0 || r[4] <= 0.0;
+      const bool bad = l[0] <= 0.0 || r[0] <= 0.0 || l[4] <= 0.0 || r[4] <= 0.0;
       if (!bad) {
         for (int f = 0; f < 5; ++f) {
           lo[f] = l[f];
@@ -83,14 +100,6 @@ void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<st
     }
   }
   for (int f = 0; f < 5; ++f) lo[f] = hi[f] = q[f];
-}
-
-/// Two-sided face values of `cell` along D (what the sweeps used).
-template <int D, class Flux, class Recon>
-void sweep_cell_faces(const face_kernel<Flux, Recon>& fk, index_t cell, index_t ia, double* lo, double* hi) {
-  double* pl[5] = {&lo[0], &lo[1], &lo[2], &lo[3], &lo[4]};
-  double* ph[5] = {&hi[0], &hi[1], &hi[2], &hi[3], &hi[4]};
-  fk.template cell_faces<D, double>(cell, fk.grid.stride(D), ia, pl, ph, 0);
 }
 
 inline prim<double> prim_of(const double* v) { return {v[0], {v[1], v[2], v[3]}, v[4]}; }
@@ -109,14 +118,7 @@ void correct_neighbour_face(const face_kernel<Flux, Recon>& fk, const stage_geom
   blocked_cell_faces<D>(fk, blocked, a, ia, la1, ha1);
   blocked_cell_faces<D>(fk, blocked, b, ia + 1, lb1, hb1);
   const vec3<double> n = geo.n[std::size_t(D)];
-  auto ijk = grid.ijk(b);
-  vec3<double> centre{grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
-  const double xf = grid.face(D, ijk[std::size_t(D)]);
-  if constexpr (D == 0) centre.x = xf;
-  else if constexpr (D == 1) centre.y = xf;
-  else centre.z = xf;
-  const Eigen::Vector3d cE(centre.x, centre.y, centre.z);
-  const double wn = geo.vh[D] + geo.oh.cross(cE)[D];
+  const double wn = face_speed(geo, D, face_centre(grid, D, b));
   const cons<double> F0 = flux::ale_flux(fk.flux, prim_of(ha), prim_of(lb), n, wn, fk.gas);
   const cons<double> F1 = flux::ale_flux(fk.flux, prim_of(ha1), prim_of(lb1), n, wn, fk.gas);
   const double dF[5] = {F1.rho - F0.rho, F1.m.x - F0.m.x, F1.m.y - F0.m.y, F1.m.z - F0.m.z, F1.E - F0.E};
@@ -178,27 +180,27 @@ void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, 
     fc.L = prim_of(hi_m);
     fc.R = prim_of(lo_c);
     fc.n = geo.n[std::size_t(d)];
-    fc.centre = {grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
-    fc.centre[d] = grid.face(d, ic);
-    fc.wn = geo.vh[d] + geo.oh.cross(fc.centre)[d];
+    fc.centre = face_centre(grid, d, c);
+    fc.wn = face_speed(geo, d, fc.centre);
     const int a = (d + 1) % 3, b = (d + 2) % 3;
     fc.area = grid.width(a, ijk[std::size_t(a)]) * grid.width(b, ijk[std::size_t(b)]);
     const cons<double> F = flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
-    if (one_sided && interior(faces[pi])) {
+    if constexpr (one_sided) {
       // The membrane sees the one-sided face states; the unblocked neighbouring faces are
       // recomputed with them (each once, see the file comment).
-      with_axis([&](auto D) {
-        double l1[5], h1[5];
-        blocked_cell_faces<decltype(D)::value>(fk, blocked, m, ic - 1, l1, h1);
-        fc.L = prim_of(h1);
-        blocked_cell_faces<decltype(D)::value>(fk, blocked, c, ic, l1, h1);
-        fc.R = prim_of(l1);
-        const std::uint8_t lo_bit = std::uint8_t(1u << (2 * d)), hi_bit = std::uint8_t(1u << (2 * d + 1));
-        if (!(blocked[std::size_t(m)] & lo_bit))
-          correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, m - s, ic - 2, dU);
-        if (!(blocked[std::size_t(c)] & hi_bit) && !(blocked[std::size_t(c + s)] & hi_bit))
-          correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, c, ic, dU);
-      });
+      if (interior(faces[pi]))
+        with_axis([&](auto D) {
+          double l1[5], h1[5];
+          blocked_cell_faces<decltype(D)::value>(fk, blocked, m, ic - 1, l1, h1);
+          fc.L = prim_of(h1);
+          blocked_cell_faces<decltype(D)::value>(fk, blocked, c, ic, l1, h1);
+          fc.R = prim_of(l1);
+          const std::uint8_t lo_bit = std::uint8_t(1u << (2 * d)), hi_bit = std::uint8_t(1u << (2 * d + 1));
+          if (!(blocked[std::size_t(m)] & lo_bit))
+            correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, m - s, ic - 2, dU);
+          if (!(blocked[std::size_t(c)] & hi_bit) && !(blocked[std::size_t(c + s)] & hi_bit))
+            correct_neighbour_face<decltype(D)::value>(fk, geo, blocked, c, ic, dU);
+        });
     }
     cons<double> Flo = F, Fhi = F;
     patcher.patch(fc, state, Flo, Fhi);

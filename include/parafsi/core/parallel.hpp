@@ -48,11 +48,16 @@ inline constexpr bool enabled() noexcept {
 
 /// for i in [begin, end): f(i), iterations split statically over threads.
 /// Use only when iterations write disjoint data. `threaded = false` runs serially
-/// (small problems: a parallel region costs more than it saves).
+/// without entering a parallel region (small problems, and kernels called per block from
+/// a block-parallel loop: an inactive region still costs a runtime call).
 template <class F>
 inline void for_range(index_t begin, index_t end, F&& f, bool threaded = true) {
 #if defined(_OPENMP)
-#pragma omp parallel for schedule(static) if (threaded)
+  if (!threaded) {
+    for (index_t i = begin; i < end; ++i) f(i);
+    return;
+  }
+#pragma omp parallel for schedule(static)
   for (index_t i = begin; i < end; ++i) f(i);
 #else
   (void)threaded;

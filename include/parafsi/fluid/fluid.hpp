@@ -3,6 +3,7 @@
 /// boundaries, the solver and the exact Riemann solver.
 #pragma once
 
+#include "block_solver.hpp"
 #include "boundary/condition.hpp"
 #include "exact_riemann.hpp"
 #include "fields.hpp"

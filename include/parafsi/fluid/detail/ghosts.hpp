@@ -4,7 +4,11 @@
 /// over all (i, j), so edges and corners get filled. Periodic faces copy the opposite
 /// interior layers; the others get cond.ghost(W_mirror, W_adjacent, n_out, w_n, gas, t)
 /// with w_n the grid's outward normal speed at the boundary face centre.
+/// On a block mesh a block fills only its faces on the box boundary (`fill`); the
+/// ghosts of its other faces come from neighbouring blocks first, so the transverse
+/// ranges then include those ghosts (edges and corners get the boundary's image of them).
 #pragma once
+#include <array>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -16,19 +20,24 @@
 
 namespace parafsi::fluid::detail {
 
+inline constexpr std::array<bool, 6> all_faces{true, true, true, true, true, true};
+
 inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
-                        const stage_geometry& geo, double t, const fields5<double>& U, bool threaded) {
+                        const stage_geometry& geo, double t, const fields5<double>& U, bool threaded,
+                        const std::array<bool, 6>& fill = all_faces) {
   constexpr index_t ng = rectilinear_grid::ghosts;
   const index_t n[3] = {grid.n(0), grid.n(1), grid.n(2)};
   for (int d = 0; d < 3; ++d) {
     const int a = (d + 1) % 3, b = (d + 2) % 3;
-    // Ranges of the two transverse axes.
+    // Ranges of the two transverse axes: include the ghosts already filled (axes done
+    // before this one, and faces filled from neighbouring blocks).
     auto range = [&](int axis) -> std::pair<index_t, index_t> {
-      if (axis < d) return {-ng, n[axis] + ng};  // already filled axes: include ghosts
-      return {0, n[axis]};
+      const bool lo = axis < d || !fill[std::size_t(2 * axis)], hi = axis < d || !fill[std::size_t(2 * axis + 1)];
+      return {lo ? -ng : 0, hi ? n[axis] + ng : n[axis]};
     };
     const auto ra = range(a), rb = range(b);
     for (int hi = 0; hi < 2; ++hi) {
+      if (!fill[std::size_t(2 * d + hi)]) continue;
       const auto& bc = bcs.face[std::size_t(2 * d + hi)];
       const vec3<double> nout = geo.n[std::size_t(d)] * (hi ? 1.0 : -1.0);
       std::visit(

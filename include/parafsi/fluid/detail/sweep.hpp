@@ -10,6 +10,7 @@
 /// fluxes, so every slope is computed once and every cell is written once per axis.
 #pragma once
 #include <array>
+#include <type_traits>
 #include <vector>
 
 #include "../../core/parallel.hpp"
@@ -118,10 +119,20 @@ PARAFSI_INLINE void store_flux(double* const* out, index_t o, const auto& F) noe
   simd::store(out[4] + o, F.E);
 }
 
+/// Where a sweep leaves the fluxes of the grid's two boundary faces along its axis (a
+/// block of a block mesh: coarse–fine flux correction); `no_register` keeps none.
+struct no_register {};
+/// Five component arrays per side, indexed by the transverse cell: j + n_y k (x faces),
+/// i + n_x k (y faces), i + n_x j (z faces).
+struct face_register {
+  fields5<double> lo{}, hi{};
+};
+
 /// Inviscid fluxes along axis D accumulated into dU (D = 0 initialises dU).
-template <int D, class Flux, class Recon>
+template <int D, class Flux, class Recon, class Register = no_register>
 void sweep(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const fields5<double>& dU,
-           std::vector<row_buffers>& bufs, bool threaded) {
+           std::vector<row_buffers>& bufs, bool threaded, const Register& reg = {}) {
+  constexpr bool keep = std::is_same_v<Register, face_register>;
   const rectilinear_grid& grid = fk.grid;
   const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
   const vec3<double> n = geo.n[D];
@@ -149,6 +160,11 @@ void sweep(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const 
         using V = typename decltype(tag)::type;
         store_flux(fb.data(), i, fk.template face_flux<V>(hi.data(), i, lo.data(), i + 1, V(wn), n));
       });
+      if constexpr (keep)
+        for (int f = 0; f < 5; ++f) {
+          reg.lo[f][r] = fb[f][0];
+          reg.hi[f][r] = fb[f][nx];
+        }
       simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
         using V = typename decltype(tag)::type;
         const V id = simd::load<V>(idx + i);
@@ -181,6 +197,12 @@ void sweep(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const 
             const V wn = V(wconst) + V(wslope) * simd::load<V>(x0 + i);
             store_flux(cur.data(), i, fk.template face_flux<V>(hi_prev.data(), i, lo.data(), i, wn, n));
           });
+          if constexpr (keep)
+            if (row == 0 || row == nD) {
+              const fields5<double>& side = row == 0 ? reg.lo : reg.hi;
+              for (int f = 0; f < 5; ++f)
+                for (index_t i = 0; i < nx; ++i) side[f][i + nx * q] = cur[f][i];
+            }
           if (row >= 1) {
             const index_t cbase = base - s;  // cell row−1 receives F_{row−1/2} − F_{row+1/2}
             const double id = idx[row - 1];

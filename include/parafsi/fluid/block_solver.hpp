@@ -292,6 +292,43 @@ class block_solver {
   }
   void step(double dt) { step(dt, plan_motion(dt)); }
 
+  // ------------------------------------------------------------------ regrid
+  /// Adapt the mesh to `target(location) → level`: a leaf below its target level is split
+  /// (with the balance splits it needs), a family of 8 leaves that all want a coarser level
+  /// is merged where the balance allows. The state moves conservatively: a new finer leaf
+  /// takes limited-linear prolongation of its old ancestor cell (minmod slopes from the
+  /// old mesh, ghosts included, offsets of the fine centres in coarse widths, so the
+  /// children average back to the parent), a new coarser leaf the volume mean of the old
+  /// cells it covers. Levels are capped at max_level. Returns whether the mesh changed.
+  template <class Target>
+  bool regrid(Target&& target, int max_level) {
+    require(max_level >= 0 && max_level <= blocks::tree::max_depth,
+            "fluid::block_solver::regrid: max_level must be "
+            "in [0, ",
+            blocks::tree::max_depth, "], got ", max_level);
+    auto want = [&](const blocks::location& q) { return std::min(max_level, int(target(q))); };
+    blocks::tree next = tree_;
+    next.refine_where(max_level, [&](const blocks::location& q) { return want(q) > q.level; });
+    for (bool merged = true; merged;) {
+      merged = false;
+      for (const auto& q : std::vector<blocks::location>(next.leaves())) {
+        if (q.level == 0 || !next.is_leaf(q)) continue;
+        const blocks::location p = q.parent();
+        bool all = true;
+        for (int c = 0; c < 8 && all; ++c) all = next.is_leaf(p.child(c)) && want(p.child(c)) < p.level + 1;
+        if (all && next.coarsen(p)) merged = true;
+      }
+    }
+    if (next.leaves() == tree_.leaves()) return false;
+    fill_ghosts_all(t_);  // the old mesh's ghosts feed the prolongation slopes
+    std::vector<block> old = std::move(blocks_);
+    blocks::tree old_tree = std::move(tree_);
+    tree_ = std::move(next);
+    build();
+    transfer(old, old_tree);
+    return true;
+  }
+
  private:
   // ------------------------------------------------------------------ mesh
   void build() {
@@ -389,6 +426,94 @@ class block_solver {
         detail::sweep<2>(fk, geo, dU, bufs, false, register_of(b, 2));
       });
       detail::par_for(threaded_, 0, nb, [&](index_t id) { correct_fluxes(id); });
+    });
+  }
+
+  /// Every block's ghosts: from neighbours, then the box's boundary conditions.
+  void fill_ghosts_all(double t) {
+    const auto geo = detail::geometry(pose_);
+    const index_t nb = block_count();
+    detail::par_for(threaded_, 0, nb,
+                    [&](index_t id) { blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_); });
+    detail::par_for(threaded_, 0, nb, [&](index_t id) {
+      block& b = blocks_[std::size_t(id)];
+      if (b.boundary != std::array<bool, 6>{})
+        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary);
+    });
+  }
+
+  /// Move the state of the old leaves onto the new ones (regrid).
+  void transfer(const std::vector<block>& old, const blocks::tree& old_tree) {
+    const index_t n = n_;
+    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+      block& nbk = blocks_[std::size_t(id)];
+      const blocks::location q = nbk.where;
+      const auto U = detail::conserved_ptrs(nbk.U);
+      const blocks::cover c = old_tree.find(q);
+      if (c.kind == blocks::cover::leaf) {
+        const block& ob = old[std::size_t(c.id)];
+        const auto V = detail::conserved_ptrs(ob.U);
+        const int k = q.level - ob.where.level;  // 0: same block; > 0: prolong
+        const double scale = 1.0 / double(std::int64_t(1) << k);
+        for (index_t kk = 0; kk < n; ++kk)
+          for (index_t j = 0; j < n; ++j)
+            for (index_t i = 0; i < n; ++i) {
+              const index_t G[3] = {q.l[0] * n + i, q.l[1] * n + j, q.l[2] * n + kk};
+              index_t C[3];
+              double off[3];
+              for (int d = 0; d < 3; ++d) {
+                const index_t Cg = G[d] >> k;
+                C[d] = Cg - ob.where.l[std::size_t(d)] * n;
+                off[d] = (double(G[d]) + 0.5) * scale - (double(Cg) + 0.5);
+              }
+              const index_t src = ob.grid.index(C[0], C[1], C[2]);
+              const index_t dst = nbk.grid.index(i, j, kk);
+              if (k == 0) {
+                for (int f = 0; f < 5; ++f) U[f][dst] = V[f][src];
+                continue;
+              }
+              double qv[5], cv[5];
+              for (int f = 0; f < 5; ++f) {
+                cv[f] = V[f][src];
+                qv[f] = cv[f];
+                for (int d = 0; d < 3; ++d) {
+                  const index_t st = ob.grid.stride(d);
+                  const double a = cv[f] - V[f][src - st], b = V[f][src + st] - cv[f];
+                  const double sl = a * b > 0.0 ? (std::fabs(a) < std::fabs(b) ? a : b) : 0.0;
+                  qv[f] += off[d] * sl;
+                }
+              }
+              const bool ok = qv[0] > 0.0 && gas_.pressure(qv[0], qv[1], qv[2], qv[3], qv[4]) > 0.0;
+              for (int f = 0; f < 5; ++f) U[f][dst] = ok ? qv[f] : cv[f];
+            }
+        return;
+      }
+      // Coarser new leaf: volume means of the old descendants' cells.
+      for (int f = 0; f < 5; ++f)
+        for (index_t kk = 0; kk < n; ++kk)
+          for (index_t j = 0; j < n; ++j)
+            for (index_t i = 0; i < n; ++i) U[f][nbk.grid.index(i, j, kk)] = 0.0;
+      auto gather = [&](auto&& self, const blocks::location& o) -> void {
+        const index_t oid = old_tree.id_of(o);
+        if (oid < 0) {
+          for (int ch = 0; ch < 8; ++ch) self(self, o.child(ch));
+          return;
+        }
+        const int k = o.level - q.level;
+        const block& ob = old[std::size_t(oid)];
+        const auto V = detail::conserved_ptrs(ob.U);
+        const double w = 1.0 / double(std::int64_t(1) << (3 * k));
+        for (index_t kk = 0; kk < n; ++kk)
+          for (index_t j = 0; j < n; ++j)
+            for (index_t i = 0; i < n; ++i) {
+              const index_t G[3] = {o.l[0] * n + i, o.l[1] * n + j, o.l[2] * n + kk};
+              const index_t dst = nbk.grid.index((G[0] >> k) - q.l[0] * n, (G[1] >> k) - q.l[1] * n,
+                                                 (G[2] >> k) - q.l[2] * n);
+              const index_t src = ob.grid.index(i, j, kk);
+              for (int f = 0; f < 5; ++f) U[f][dst] += w * V[f][src];
+            }
+      };
+      for (int ch = 0; ch < 8; ++ch) gather(gather, q.child(ch));
     });
   }
 

@@ -4,7 +4,9 @@
 // and a uniform stream stays uniform on a moving, turning box.
 #include <doctest/doctest.h>
 
+#include <filesystem>
 #include <map>
+#include <parafsi/io/checkpoint.hpp>
 
 #include "fluid_test_util.hpp"
 
@@ -380,4 +382,85 @@ TEST_CASE("regrid: the refined region follows a moving vortex, conserving to rou
   const auto ex = ve(ve.cx, ve.cy);
   MESSAGE("pressure at the vortex centre: ", w.p, " (exact ", ex.p, ")");
   CHECK(w.p == doctest::Approx(ex.p).epsilon(0.05));
+}
+
+TEST_CASE("block mesh: the far-field sponge and sources match the box solver on one level") {
+  // A pressure pulse in a far-field box with a 4-cell sponge, and a uniform momentum and
+  // energy source: the one-level block mesh gives the box solver's answer to round-off.
+  boundary::set bc = boundary::set::all(boundary::far_field{1.18, {0, 0, 0}, 101325.0});
+  bc.layer = {4, 0.5};
+  auto [blk, box] = twin({3, 2, 2}, 8, {-1.5, -1, -1}, {1.5, 1, 1}, bc, {false, false, false});
+  auto pulse = [](const Eigen::Vector3d& x) {
+    return prim{1.18, {0, 0, 0}, 101325.0 * (1 + 0.05 * std::exp(-x.squaredNorm() / 0.1))};
+  };
+  blk.initialize(pulse);
+  box.initialize(pulse);
+  blk.enable_sources();
+  box.enable_sources();
+  for (index_t id = 0; id < blk.block_count(); ++id)
+    for (index_t c = 0; c < blk.block_at(id).grid.total_cells(); ++c) {
+      blk.source(id, 0)[c] = 3.0;
+      blk.source(id, 3)[c] = 40.0;
+    }
+  for (index_t c = 0; c < box.grid().total_cells(); ++c) {
+    box.source(0)[c] = 3.0;
+    box.source(3)[c] = 40.0;
+  }
+  for (int n = 0; n < 40; ++n) {
+    const double dt = box.stable_dt(0.5);
+    box.step(dt);
+    blk.step(dt);
+  }
+  const double e = max_difference(blk, box);
+  MESSAGE("sponge of 4 cells + sources, 12 blocks vs the 24x16x16 box after 40 steps: max relative difference ", e);
+  CHECK(e < 1e-13);
+  // The sponge reaches exactly the outer 4 cells.
+  const auto [id_in, c_in] = blk.locate({-1.5 + 3.5 / 8.0, 0.01, 0.01});
+  const auto [id_out, c_out] = blk.locate({-1.5 + 4.5 / 8.0, 0.01, 0.01});
+  CHECK(blk.sponge_rate(id_in, c_in) > 0.0);
+  CHECK(blk.sponge_rate(id_out, c_out) == 0.0);
+}
+
+TEST_CASE("block mesh: a checkpoint restores a regridded mesh and the run continues bit for bit") {
+  fluid::block_layout lay{{0, 0, 0}, {10, 10, 2.5}, {4, 4, 1}, 8};
+  fluid::reference::isentropic_vortex v{};
+  v.cx = 3.0;
+  v.cy = 4.0;
+  v.period = 10.0;
+  auto target = [](const fb::location& q) { return q.level == 0 && q.l[0] == 1 && q.l[1] == 1 ? 1 : q.level; };
+  auto make = [&] {
+    return fluid::block_solver{fb::tree({4, 4, 1}, {true, true, true}), lay, boundary::set::all(boundary::periodic{}),
+                               frame::rigid{Eigen::Vector3d(1.0, 0.5, 0.0), Eigen::Vector3d(0, 0, 0.2)}};
+  };
+  auto a = make();
+  a.initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+  a.enable_sources();
+  for (int n = 0; n < 5; ++n) a.step(a.stable_dt(0.5));
+  CHECK(a.regrid(target, 1));
+  a.source(0, 4)[a.block_at(0).grid.index(1, 1, 1)] = 0.25;
+  const auto path = std::filesystem::temp_directory_path() / "parafsi_test_blocks.ckpt";
+  io::save_checkpoint(path, a);
+  auto b = make();  // one level: the restart rebuilds the refined tree
+  io::load_checkpoint(path, b);
+  CHECK(b.block_count() == a.block_count());
+  for (int n = 0; n < 5; ++n) {
+    const double dt = a.stable_dt(0.5);
+    CHECK(b.stable_dt(0.5) == dt);
+    a.step(dt);
+    b.step(dt);
+  }
+  bool same = a.time() == b.time() && a.steps() == b.steps() && a.pose().R == b.pose().R;
+  a.for_each_cell([&](const auto& blk, index_t i, index_t j, index_t k) {
+    const index_t id = &blk - &a.block_at(0);
+    const index_t c = blk.grid.index(i, j, k);
+    same = same && blk.U.template get<fluid::field::E>()[c] == b.block_at(id).U.template get<fluid::field::E>()[c];
+  });
+  CHECK(same);
+  // Another layout is refused, naming it.
+  fluid::block_layout other = lay;
+  other.root_blocks = {2, 2, 1};
+  fluid::block_solver c{fb::tree({2, 2, 1}, {true, true, true}), other, boundary::set::all(boundary::periodic{}),
+                        frame::rigid{}};
+  CHECK_THROWS_WITH_AS(io::load_checkpoint(path, c), doctest::Contains("root blocks on axis 0"), io::checkpoint_error);
+  std::filesystem::remove(path);
 }

@@ -14,14 +14,18 @@
 /// count.
 ///
 /// The frame (translate, rigid, follow_payload), the gas and the flux, reconstruction and
-/// time policies are those of solver.hpp. Inviscid only for now (the viscous pass would
-/// need its own coarse–fine flux correction); no sponge and no coupling sources yet.
+/// time policies are those of solver.hpp, and so are the optional per-cell sources (held
+/// constant over a step) and the far-field sponge: σ = s c_∞/L_s ((L − d)/L)³ with d the
+/// cell centre's distance from a far-field face in root-level cells less ½ and L_s = L
+/// root-level cells, which is the box solver's layer on a one-level mesh. Inviscid only
+/// for now (the viscous pass would need its own coarse–fine flux correction).
 ///
 /// References: Berger M.J., Colella P. (1989) J. Comput. Phys. 82:64;
 ///   Stone J.M. et al. (2020) ApJS 249:4 (Athena++); Zhang W. et al. (2019) JOSS 4:1370 (AMReX).
 #pragma once
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +40,7 @@
 #include "boundary/condition.hpp"
 #include "detail/ghosts.hpp"
 #include "detail/primitives.hpp"
+#include "detail/sources.hpp"
 #include "detail/stable_dt.hpp"
 #include "detail/stage.hpp"
 #include "detail/sweep.hpp"
@@ -90,6 +95,8 @@ class block_solver {
   static constexpr index_t ng = rectilinear_grid::ghosts;
   using cons_storage = soa_of_t<conserved_fields>;
   using prim_storage = soa_of_t<primitive_fields>;
+  /// io::save_checkpoint / load_checkpoint store the block mesh in this section.
+  static constexpr const char* checkpoint_section = "fluid_blocks";
 
   /// One leaf of the mesh: its grid (box coordinates), state, rates and face register.
   struct block {
@@ -97,8 +104,10 @@ class block_solver {
     rectilinear_grid grid;
     cons_storage U, U0, dU;
     prim_storage W;
-    simd::aligned_vector<double> faces;  ///< face register: [axis][side][component][n²]
-    std::array<bool, 6> boundary{};      ///< faces on the box boundary filled by a condition
+    simd::aligned_vector<double> faces;              ///< face register: [axis][side][component][n²]
+    std::optional<soa_of_t<source_fields>> sources;  ///< per-cell sources (enable_sources)
+    std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
+    std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
     std::vector<char> bad_rows;
   };
 
@@ -124,7 +133,7 @@ class block_solver {
               "fluid::block_solver: the tree has ", tree_.root_blocks()[std::size_t(d)], " root blocks on axis ", d,
               " but the layout ", layout_.root_blocks[std::size_t(d)]);
     }
-    require(bc_.layer.cells == 0, "fluid::block_solver: a sponge layer is not available on the block mesh yet");
+    sponge_target_ = detail::sponge_target(bc_, gas_, sponge_target_);
     build();
     fill_uniform({1.18, {0.0, 0.0, 0.0}, 101325.0});
   }
@@ -231,6 +240,32 @@ class block_solver {
            ", " + Time::name() + ", blocks of " + std::to_string(n_) + "^3>";
   }
 
+  /// Enable the per-cell source hook on every block (zero-initialised; kept through
+  /// regrids, which zero them): momentum N/m³ and energy W/m³ (inertial), mass kg/(m³ s).
+  void enable_sources() {
+    sources_on_ = true;
+    for (auto& b : blocks_)
+      if (!b.sources) b.sources.emplace(b.grid.total_cells(), 0.0);
+  }
+  bool has_sources() const noexcept { return sources_on_; }
+  /// Source array of block `id`: component 0–2 momentum, 3 energy, 4 mass.
+  double* source(index_t id, int component) {
+    require(sources_on_, "fluid::block_solver::source: call enable_sources() first");
+    auto& S = *blocks_[std::size_t(id)].sources;
+    switch (component) {
+      case 0: return S.template get<field::s_mx>();
+      case 1: return S.template get<field::s_my>();
+      case 2: return S.template get<field::s_mz>();
+      case 3: return S.template get<field::s_E>();
+      default: return S.template get<field::s_rho>();
+    }
+  }
+  /// Sponge rate σ of a leaf cell (0 outside the layer).
+  double sponge_rate(index_t id, index_t cell) const noexcept {
+    const block& b = blocks_[std::size_t(id)];
+    return b.sponge ? b.sponge->template get<field::sponge_sigma>()[cell] : 0.0;
+  }
+
   /// Sums over leaf cells, blocks in tree order (bit-reproducible).
   fluid::totals totals() const {
     fluid::totals t;
@@ -291,6 +326,62 @@ class block_solver {
     ++steps_;
   }
   void step(double dt) { step(dt, plan_motion(dt)); }
+
+  // ------------------------------------------------------------------ checkpoint
+  /// Checkpoint (io/archive.hpp): the signature (type, ghosts, layout, gas), then time,
+  /// steps, pose, frame, the leaves (level and position; a restart rebuilds the tree and
+  /// its plans from them) and every block's conserved fields (ghosts and padding
+  /// included) and sources.
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& self) {
+    ar.check("type", self.name(), "the solver type");
+    ar.check("ghosts", std::int64_t(ng), "the number of ghost layers");
+    for (int d = 0; d < 3; ++d) {
+      const std::string a = std::to_string(d);
+      ar.check("layout.lo" + a, self.layout_.lo[std::size_t(d)], "the box's lower corner on axis " + a);
+      ar.check("layout.hi" + a, self.layout_.hi[std::size_t(d)], "the box's upper corner on axis " + a);
+      ar.check("layout.root_blocks" + a, std::int64_t(self.layout_.root_blocks[std::size_t(d)]),
+               "the root blocks on axis " + a);
+    }
+    ar.check("field_length", std::int64_t(simd::padded(std::size_t(self.blocks_[0].grid.total_cells())) + simd::width),
+             "the block field length (cells + SIMD padding; another SIMD width?)");
+    ar.check("gas.gamma", self.gas_.gamma, "gas gamma");
+    ar.check("gas.R", self.gas_.R, "gas constant R");
+    ar("time", self.t_);
+    ar("steps", self.steps_);
+    ar("pose.X", self.pose_.X);
+    ar("pose.R", self.pose_.R);
+    ar("pose.V", self.pose_.V);
+    ar("pose.Omega", self.pose_.Omega);
+    ar("frame", self.frame_);
+    std::int64_t count = self.tree_.size();
+    ar("leaf_count", count);
+    std::vector<std::int64_t> leaves;
+    if constexpr (Archive::loading) {
+      if (count < 1 || count > (std::int64_t(1) << 40)) ar.fail("leaf_count ", count, " is not a number of blocks");
+      leaves.resize(std::size_t(4 * count));
+    } else {
+      for (const auto& q : self.tree_.leaves()) leaves.insert(leaves.end(), {q.level, q.l[0], q.l[1], q.l[2]});
+    }
+    ar("leaves", leaves);
+    bool sources = self.sources_on_;
+    ar("sources", sources);
+    if constexpr (Archive::loading) {
+      std::vector<blocks::location> list(static_cast<std::size_t>(count));
+      for (std::size_t i = 0; i < list.size(); ++i)
+        list[i] = {int(leaves[4 * i]), {leaves[4 * i + 1], leaves[4 * i + 2], leaves[4 * i + 3]}};
+      std::array<bool, 3> per{self.tree_.periodic(0), self.tree_.periodic(1), self.tree_.periodic(2)};
+      self.tree_ = blocks::tree::from_leaves(self.layout_.root_blocks, per, list);
+      self.sources_on_ = self.sources_on_ || sources;
+      self.build();
+    }
+    for (std::size_t id = 0; id < self.blocks_.size(); ++id) {
+      auto& b = self.blocks_[id];
+      const std::string g = "block" + std::to_string(id);
+      ar.fields(g + ".conserved", b.U);
+      if (sources) ar.fields(g + ".sources", *b.sources);
+    }
+  }
 
   // ------------------------------------------------------------------ regrid
   /// Adapt the mesh to `target(location) → level`: a leaf below its target level is split
@@ -361,6 +452,8 @@ class block_solver {
       b.W.resize(N, 1.0);
       b.faces.assign(std::size_t(3 * 2 * 5 * n2), 0.0);
       b.bad_rows.assign(std::size_t(n2), 0);
+      if (sources_on_) b.sources.emplace(N, 0.0);
+      setup_sponge(b);
     }
     plan_ = blocks::build_plan(tree_, n_);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
@@ -427,6 +520,8 @@ class block_solver {
       });
       detail::par_for(threaded_, 0, nb, [&](index_t id) { correct_fluxes(id); });
     });
+    if (sources_on_ || bc_.layer.cells > 0)
+      timed(times_.sources, [&] { detail::par_for(threaded_, 0, nb, [&](index_t id) { add_sources(id); }); });
   }
 
   /// Every block's ghosts: from neighbours, then the box's boundary conditions.
@@ -517,6 +612,53 @@ class block_solver {
     });
   }
 
+  void add_sources(index_t id) {
+    block& b = blocks_[std::size_t(id)];
+    const auto dU = detail::conserved_ptrs(b.dU);
+    const auto U = detail::conserved_ptrs(std::as_const(b.U));
+    detail::fields5<const double> src{};
+    if (b.sources)
+      src = {b.sources->template get<field::s_rho>(), b.sources->template get<field::s_mx>(),
+             b.sources->template get<field::s_my>(), b.sources->template get<field::s_mz>(),
+             b.sources->template get<field::s_E>()};
+    const double* sig = b.sponge ? b.sponge->template get<field::sponge_sigma>() : nullptr;
+    if (b.sources && sig) detail::add_sources<true, true>(b.grid, dU, U, src, sig, sponge_target_, false);
+    else if (b.sources) detail::add_sources<true, false>(b.grid, dU, U, src, sig, sponge_target_, false);
+    else if (sig) detail::add_sources<false, true>(b.grid, dU, U, src, sig, sponge_target_, false);
+  }
+
+  /// σ on the cells of a block within the layer of a far-field face (none: no array).
+  void setup_sponge(block& b) const {
+    const boundary::sponge& layer = bc_.layer;
+    if (layer.cells <= 0) return;
+    const double cinf = detail::sponge_sound_speed(bc_, gas_);
+    bool any = false;
+    std::vector<double> sig(std::size_t(b.grid.total_cells()), 0.0);
+    for (index_t k = 0; k < n_; ++k)
+      for (index_t j = 0; j < n_; ++j)
+        for (index_t i = 0; i < n_; ++i) {
+          const index_t ijk[3] = {i, j, k};
+          double s = 0.0;
+          for (int d = 0; d < 3; ++d) {
+            const double h0 = layout_.block_width(d, 0) / double(n_);  // root-level cell
+            for (int hi = 0; hi < 2; ++hi) {
+              if (!std::holds_alternative<boundary::far_field>(bc_.face[std::size_t(2 * d + hi)])) continue;
+              const double face = hi ? layout_.hi[std::size_t(d)] : layout_.lo[std::size_t(d)];
+              const double gap = std::fabs(face - b.grid.centre(d, ijk[d])) - 0.5 * b.grid.width(d, ijk[d]);
+              double dist = gap / h0;  // whole root cells snap to integers against round-off
+              if (std::fabs(dist - std::round(dist)) < 1e-9) dist = std::round(dist);
+              s = std::max(s, detail::sponge_rate(layer, cinf, double(layer.cells) * h0, dist));
+            }
+          }
+          sig[std::size_t(b.grid.index(i, j, k))] = s;
+          any = any || s > 0.0;
+        }
+    if (!any) return;
+    b.sponge.emplace(b.grid.total_cells(), 0.0);
+    double* out = b.sponge->template get<field::sponge_sigma>();
+    for (std::size_t c = 0; c < sig.size(); ++c) out[c] = sig[c];
+  }
+
   /// Replace this coarse block's fluxes at its coarse–fine faces by the fine means.
   void correct_fluxes(index_t id) {
     block& b = blocks_[std::size_t(id)];
@@ -568,6 +710,8 @@ class block_solver {
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;
   std::vector<std::vector<detail::row_buffers>> bufs_;  ///< per thread of the block loop
+  bool sources_on_ = false;
+  cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   phase_times times_{};
   bool threaded_ = false;
 };

@@ -18,6 +18,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <unordered_map>
@@ -63,6 +64,36 @@ class tree {
       for (index_t j = 0; j < nb[1]; ++j)
         for (index_t i = 0; i < nb[0]; ++i) leaves_.emplace(key({0, {i, j, k}}), location{0, {i, j, k}});
     order();
+  }
+
+  /// A tree from its leaves (a checkpoint): they must lie in the box, not overlap and
+  /// fill it; balance is checked where the exchange plan is built.
+  static tree from_leaves(std::array<index_t, 3> nb, std::array<bool, 3> periodic,
+                          const std::vector<location>& leaves) {
+    tree t(nb, periodic);
+    t.leaves_.clear();
+    double volume = 0.0;
+    for (const auto& q : leaves) {
+      require(q.level >= 0 && q.level <= max_depth, "blocks::tree::from_leaves: level ", q.level, " out of range");
+      for (int d = 0; d < 3; ++d)
+        require(q.l[std::size_t(d)] >= 0 && q.l[std::size_t(d)] < t.extent(d, q.level),
+                "blocks::tree::from_leaves: "
+                "level ",
+                q.level, " block (", q.l[0], ", ", q.l[1], ", ", q.l[2], ") lies outside the box");
+      require(t.leaves_.emplace(key(q), q).second, "blocks::tree::from_leaves: block (", q.l[0], ", ", q.l[1], ", ",
+              q.l[2], ") of level ", q.level, " is listed twice");
+      volume += std::ldexp(1.0, -3 * q.level);
+    }
+    for (const auto& q : leaves)
+      for (location p = q; p.level > 0;) {
+        p = p.parent();
+        require(!t.leaves_.count(key(p)), "blocks::tree::from_leaves: level ", q.level, " block (", q.l[0], ", ",
+                q.l[1], ", ", q.l[2], ") lies inside another leaf");
+      }
+    require(volume == double(nb[0] * nb[1] * nb[2]), "blocks::tree::from_leaves: the leaves fill ", volume,
+            " root blocks of ", nb[0] * nb[1] * nb[2]);
+    t.order();
+    return t;
   }
 
   index_t size() const noexcept { return index_t(order_.size()); }

@@ -17,16 +17,31 @@
 
 namespace parafsi::fluid::detail {
 
+/// Sound speed of the first far-field face (the sponge's rate scale); 340 m/s if none.
+inline double sponge_sound_speed(const boundary::set& bcs, const gas::ideal& gas) {
+  for (const auto& f : bcs.face)
+    if (auto* ff = std::get_if<boundary::far_field>(&f)) return gas.sound_speed(ff->rho, ff->p);
+  return 340.0;
+}
+/// The sponge's target state: the first far-field face's state (else `fallback`).
+inline cons<double> sponge_target(const boundary::set& bcs, const gas::ideal& gas, const cons<double>& fallback) {
+  for (const auto& f : bcs.face)
+    if (auto* ff = std::get_if<boundary::far_field>(&f)) return to_cons(ff->state(), gas);
+  return fallback;
+}
+/// σ at a cell `dist` cells in from a far-field face, for a layer of L cells of total
+/// thickness `thick`: s c_∞/thick ((L − dist)/L)³ (0 outside the layer).
+inline double sponge_rate(const boundary::sponge& layer, double c_inf, double thick, double dist) {
+  if (!(dist < double(layer.cells))) return 0.0;
+  const double xi = (double(layer.cells) - dist) / double(layer.cells);
+  return layer.strength * c_inf / thick * xi * xi * xi;
+}
+
 /// Fill the sponge rate σ on interior cells; returns the sponge's target state.
 inline cons<double> setup_sponge(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
                                  double* sig, const cons<double>& fallback) {
   const index_t L = bcs.layer.cells;
-  double cinf = 340.0;
-  for (const auto& f : bcs.face)
-    if (auto* ff = std::get_if<boundary::far_field>(&f)) {
-      cinf = gas.sound_speed(ff->rho, ff->p);
-      break;
-    }
+  const double cinf = sponge_sound_speed(bcs, gas);
   for (index_t k = 0; k < grid.n(2); ++k)
     for (index_t j = 0; j < grid.n(1); ++j)
       for (index_t i = 0; i < grid.n(0); ++i) {
@@ -39,15 +54,11 @@ inline cons<double> setup_sponge(const rectilinear_grid& grid, const boundary::s
             if (dist >= L) continue;
             double thick = 0.0;
             for (index_t q = 0; q < L && q < grid.n(d); ++q) thick += grid.width(d, hi ? grid.n(d) - 1 - q : q);
-            const double xi = double(L - dist) / double(L);
-            s = std::max(s, bcs.layer.strength * cinf / thick * xi * xi * xi);
+            s = std::max(s, sponge_rate(bcs.layer, cinf, thick, double(dist)));
           }
         sig[grid.index(i, j, k)] = s;
       }
-  // Target state: the first far-field face's state.
-  for (const auto& f : bcs.face)
-    if (auto* ff = std::get_if<boundary::far_field>(&f)) return to_cons(ff->state(), gas);
-  return fallback;
+  return sponge_target(bcs, gas, fallback);
 }
 
 /// dU += S (Sources) and dU −= σ (U − U_∞) (Sponge) on interior cells. `src` in the

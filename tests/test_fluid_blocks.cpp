@@ -464,3 +464,36 @@ TEST_CASE("block mesh: a checkpoint restores a regridded mesh and the run contin
   CHECK_THROWS_WITH_AS(io::load_checkpoint(path, c), doctest::Contains("root blocks on axis 0"), io::checkpoint_error);
   std::filesystem::remove(path);
 }
+
+TEST_CASE("refinement near a structure: every structure point and its buffer lie on the finest level") {
+  // A canopy-like cap (radius 0.5 m, 4000 points) in a 4 x 4 x 8 m box of 2 x 2 x 4 root
+  // blocks of 8^3 (0.25 m cells), refined to level 3 (3.1 cm) within 5 cm of the points.
+  fluid::block_layout lay{{-2, -2, -4}, {2, 2, 4}, {2, 2, 4}, 8};
+  std::vector<Eigen::Vector3d> pts;
+  for (int a = 0; a < 40; ++a)
+    for (int b = 0; b < 100; ++b) {
+      const double th = 1.2 * (a + 0.5) / 40, ph = 2 * M_PI * b / 100;
+      pts.emplace_back(0.5 * std::sin(th) * std::cos(ph) + 0.13, 0.5 * std::sin(th) * std::sin(ph) - 0.07,
+                       0.5 * std::cos(th) + 0.31);
+    }
+  const double buffer = 0.05;
+  fb::near_points crit(lay, pts, buffer, 3);
+  fb::tree t({2, 2, 4});
+  t.refine_where(3, crit);
+  fluid::block_solver s{t, lay, boundary::set::all(boundary::far_field{})};
+  int off_finest = 0;
+  for (const auto& p : pts)
+    for (int corner = 0; corner < 8; ++corner) {  // the point and the corners of its buffer cube
+      Eigen::Vector3d x = p;
+      for (int d = 0; d < 3; ++d) x[d] += ((corner >> d) & 1 ? 1 : -1) * buffer / std::sqrt(3.0);
+      const auto [id, c] = s.locate(x);
+      off_finest += id < 0 || s.block_at(id).where.level != 3;
+    }
+  const double uniform = std::pow(4.0 / (0.25 / 8), 2) * (8.0 / (0.25 / 8));
+  MESSAGE(s.block_count(), " blocks, ", s.cell_count(), " cells (", 100.0 * double(s.cell_count()) / uniform,
+          " % of a uniform mesh at the finest cell); structure points or buffer corners off the finest level: ",
+          off_finest);
+  CHECK(off_finest == 0);
+  CHECK(double(s.cell_count()) < 0.05 * uniform);
+  CHECK_THROWS_WITH_AS(fb::near_points(lay, pts, -1.0, 3), doctest::Contains("buffer"), invalid_input);
+}

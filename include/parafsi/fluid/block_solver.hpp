@@ -36,6 +36,7 @@
 #include "../core/soa.hpp"
 #include "blocks/exchange.hpp"
 #include "blocks/flux_correction.hpp"
+#include "blocks/refine.hpp"
 #include "blocks/tree.hpp"
 #include "boundary/condition.hpp"
 #include "detail/ghosts.hpp"

@@ -1,0 +1,110 @@
+/// \file refine.hpp
+/// Refinement criteria for the block mesh: `target(location) → level` functions for
+/// tree::refine_where and block_solver::regrid.
+///
+///   near_points{layout, points, buffer, level}: `level` for every block whose box comes
+///     within `buffer` (m, box coordinates) of one of the points, 0 elsewhere (the 2:1
+///     balance grades the levels in between). With the structure's nodes as points and a
+///     buffer of at least the longest element edge plus the distance the structure can
+///     travel between regrids plus two finest cells (the prolongation and MUSCL
+///     stencils), every cell a membrane cuts, and its stencil, is on the finest level
+///     until the next regrid.
+///
+/// Points are binned on a uniform grid of bins one buffer-plus-block wide, so a query
+/// looks at the few bins the block's box (grown by the buffer) overlaps.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "../../core/error.hpp"
+#include "tree.hpp"
+
+namespace parafsi::fluid::blocks {
+
+/// Axis-aligned box of a block in box coordinates.
+struct block_box {
+  std::array<double, 3> lo, hi;
+};
+
+template <class Layout>
+block_box box_of(const Layout& lay, const location& q) {
+  block_box b{};
+  for (int d = 0; d < 3; ++d) {
+    const double w = lay.block_width(d, q.level);
+    b.lo[std::size_t(d)] = lay.lo[std::size_t(d)] + w * double(q.l[std::size_t(d)]);
+    b.hi[std::size_t(d)] = b.lo[std::size_t(d)] + w;
+  }
+  return b;
+}
+
+/// Distance from a point to a box (0 inside).
+inline double distance(const block_box& b, const Eigen::Vector3d& p) {
+  double d2 = 0;
+  for (int d = 0; d < 3; ++d) {
+    const double e = std::max({b.lo[std::size_t(d)] - p[d], 0.0, p[d] - b.hi[std::size_t(d)]});
+    d2 += e * e;
+  }
+  return std::sqrt(d2);
+}
+
+/// `level` near a set of points (box coordinates), 0 elsewhere.
+template <class Layout>
+class near_points {
+ public:
+  near_points(const Layout& lay, std::vector<Eigen::Vector3d> points, double buffer, int level)
+      : lay_(lay), pts_(std::move(points)), buffer_(buffer), level_(level) {
+    require(std::isfinite(buffer) && buffer >= 0, "blocks::near_points: buffer must be finite and >= 0, got ", buffer);
+    require(level >= 0 && level <= tree::max_depth, "blocks::near_points: level must be in [0, ", tree::max_depth,
+            "], got ", level);
+    for (const auto& p : pts_) require(p.allFinite(), "blocks::near_points: a point is not finite");
+    // Bins as wide as the buffer plus a root block's width / 2^level (≥ one finest block).
+    for (int d = 0; d < 3; ++d) bin_ = std::max(bin_, lay.block_width(d, level));
+    bin_ = std::max(bin_ + buffer_, 1e-12);
+    for (std::size_t i = 0; i < pts_.size(); ++i) bins_[key(bin_of(pts_[i]))].push_back(i);
+  }
+
+  int operator()(const location& q) const { return near(box_of(lay_, q)) ? level_ : 0; }
+
+  /// Whether some point lies within the buffer of the box.
+  bool near(const block_box& b) const {
+    std::array<std::int64_t, 3> a{}, z{};
+    for (int d = 0; d < 3; ++d) {
+      a[std::size_t(d)] = std::int64_t(std::floor((b.lo[std::size_t(d)] - buffer_) / bin_));
+      z[std::size_t(d)] = std::int64_t(std::floor((b.hi[std::size_t(d)] + buffer_) / bin_));
+    }
+    for (std::int64_t k = a[2]; k <= z[2]; ++k)
+      for (std::int64_t j = a[1]; j <= z[1]; ++j)
+        for (std::int64_t i = a[0]; i <= z[0]; ++i) {
+          const auto it = bins_.find(key({i, j, k}));
+          if (it == bins_.end()) continue;
+          for (std::size_t p : it->second)
+            if (distance(b, pts_[p]) <= buffer_) return true;
+        }
+    return false;
+  }
+
+ private:
+  std::array<std::int64_t, 3> bin_of(const Eigen::Vector3d& p) const {
+    return {std::int64_t(std::floor(p[0] / bin_)), std::int64_t(std::floor(p[1] / bin_)),
+            std::int64_t(std::floor(p[2] / bin_))};
+  }
+  /// Bin key (a hash: bins that collide share a list, which only costs distance checks).
+  static std::uint64_t key(const std::array<std::int64_t, 3>& c) noexcept {
+    return std::uint64_t(c[0]) * 0x9E3779B97F4A7C15ull ^ std::uint64_t(c[1]) * 0xC2B2AE3D27D4EB4Full ^
+           std::uint64_t(c[2]) * 0x165667B19E3779F9ull;
+  }
+
+  Layout lay_;
+  std::vector<Eigen::Vector3d> pts_;
+  double buffer_;
+  int level_;
+  double bin_ = 0;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins_;
+};
+
+}  // namespace parafsi::fluid::blocks

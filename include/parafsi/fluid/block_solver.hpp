@@ -25,6 +25,7 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -96,17 +97,33 @@ class block_solver {
   static constexpr index_t ng = rectilinear_grid::ghosts;
   using cons_storage = soa_of_t<conserved_fields>;
   using prim_storage = soa_of_t<primitive_fields>;
+  using source_storage = soa_of_t<source_fields>;
   /// io::save_checkpoint / load_checkpoint store the block mesh in this section.
   static constexpr const char* checkpoint_section = "fluid_blocks";
+
+  /// A block's part of a mesh-wide field storage, read like an soa (get<Tag>(), data(f)):
+  /// every field is one array over all blocks, block b's cells at b · stride(), so a cell
+  /// of the mesh is one flat index (global_index) for the couplings.
+  template <class Storage>
+  struct slice {
+    Storage* storage = nullptr;
+    index_t offset = 0;
+    template <class Tag>
+    double* get() const noexcept {
+      return storage->template get<Tag>() + offset;
+    }
+    double* data(std::size_t f) const noexcept { return storage->data(f) + offset; }
+    explicit operator bool() const noexcept { return storage != nullptr; }
+  };
 
   /// One leaf of the mesh: its grid (box coordinates), state, rates and face register.
   struct block {
     blocks::location where;
     rectilinear_grid grid;
-    cons_storage U, U0, dU;
-    prim_storage W;
+    slice<cons_storage> U, U0, dU;
+    slice<prim_storage> W;
+    slice<source_storage> sources;                   ///< per-cell sources (after enable_sources)
     simd::aligned_vector<double> faces;              ///< face register: [axis][side][component][n²]
-    std::optional<soa_of_t<source_fields>> sources;  ///< per-cell sources (enable_sources)
     std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
     std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
     std::vector<char> bad_rows;
@@ -139,14 +156,17 @@ class block_solver {
     fill_uniform({1.18, {0.0, 0.0, 0.0}, 101325.0});
   }
 
+  block_solver(const block_solver&) = delete;  // blocks point into the solver's storage
+  block_solver& operator=(const block_solver&) = delete;
+  block_solver(block_solver&&) = default;  // the storage lives on the heap: pointers stay valid
+  block_solver& operator=(block_solver&&) = default;
+
   // ------------------------------------------------------------------ set-up and access
   void fill_uniform(const prim<double>& w) {
     validate_state(w, "fill_uniform");
     const cons<double> q = to_cons(w, gas_);
-    for (auto& b : blocks_) {
-      const auto U = detail::conserved_ptrs(b.U);
-      for (index_t c = 0; c < b.grid.total_cells() + index_t(simd::width); ++c) detail::store_cons(U, c, q);
-    }
+    const auto U = detail::conserved_ptrs(*U_);
+    for (index_t c = 0; c < U_->size() + index_t(simd::width); ++c) detail::store_cons(U, c, q);
   }
   /// Initialise every leaf cell from f(ξ) → prim<double> (ξ: cell centre, box coordinates).
   template <class F>
@@ -245,14 +265,13 @@ class block_solver {
   /// regrids, which zero them): momentum N/m³ and energy W/m³ (inertial), mass kg/(m³ s).
   void enable_sources() {
     sources_on_ = true;
-    for (auto& b : blocks_)
-      if (!b.sources) b.sources.emplace(b.grid.total_cells(), 0.0);
+    if (!S_) allocate_sources();
   }
   bool has_sources() const noexcept { return sources_on_; }
   /// Source array of block `id`: component 0–2 momentum, 3 energy, 4 mass.
   double* source(index_t id, int component) {
     require(sources_on_, "fluid::block_solver::source: call enable_sources() first");
-    auto& S = *blocks_[std::size_t(id)].sources;
+    const auto& S = blocks_[std::size_t(id)].sources;
     switch (component) {
       case 0: return S.template get<field::s_mx>();
       case 1: return S.template get<field::s_my>();
@@ -261,6 +280,13 @@ class block_solver {
       default: return S.template get<field::s_rho>();
     }
   }
+  /// Cells per block in the mesh-wide arrays (ghosts and SIMD padding included).
+  index_t stride() const noexcept { return stride_; }
+  /// Flat index of cell `cell` (block-local index) of block `id` in the mesh-wide arrays.
+  index_t global_index(index_t id, index_t cell) const noexcept { return id * stride_ + cell; }
+  /// The mesh-wide conserved storage (block id at id · stride()).
+  const cons_storage& conserved_storage() const noexcept { return *U_; }
+
   /// Sponge rate σ of a leaf cell (0 outside the layer).
   double sponge_rate(index_t id, index_t cell) const noexcept {
     const block& b = blocks_[std::size_t(id)];
@@ -311,7 +337,7 @@ class block_solver {
   void step(double dt, const frame::motion& m) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
     pose_.set_motion(m);
-    for (auto& b : blocks_) copy_state(b.U0, b.U);
+    copy_state(*U0_, *U_);
     double pose_time = 0.0;
     for (int s = 0; s < Time::stages; ++s) {
       const double c = Time::c[std::size_t(s)];
@@ -344,8 +370,8 @@ class block_solver {
       ar.check("layout.root_blocks" + a, std::int64_t(self.layout_.root_blocks[std::size_t(d)]),
                "the root blocks on axis " + a);
     }
-    ar.check("field_length", std::int64_t(simd::padded(std::size_t(self.blocks_[0].grid.total_cells())) + simd::width),
-             "the block field length (cells + SIMD padding; another SIMD width?)");
+    ar.check("block_stride", std::int64_t(self.stride_),
+             "the cells per block in the field arrays (cells + SIMD padding; another SIMD width?)");
     ar.check("gas.gamma", self.gas_.gamma, "gas gamma");
     ar.check("gas.R", self.gas_.R, "gas constant R");
     ar("time", self.t_);
@@ -376,12 +402,8 @@ class block_solver {
       self.sources_on_ = self.sources_on_ || sources;
       self.build();
     }
-    for (std::size_t id = 0; id < self.blocks_.size(); ++id) {
-      auto& b = self.blocks_[id];
-      const std::string g = "block" + std::to_string(id);
-      ar.fields(g + ".conserved", b.U);
-      if (sources) ar.fields(g + ".sources", *b.sources);
-    }
+    ar.fields("conserved", *self.U_);
+    if (sources) ar.fields("sources", *self.S_);
   }
 
   // ------------------------------------------------------------------ regrid
@@ -414,6 +436,7 @@ class block_solver {
     if (next.leaves() == tree_.leaves()) return false;
     fill_ghosts_all(t_);  // the old mesh's ghosts feed the prolongation slopes
     std::vector<block> old = std::move(blocks_);
+    const std::unique_ptr<cons_storage> old_U = std::move(U_);  // the old blocks' slices point here
     blocks::tree old_tree = std::move(tree_);
     tree_ = std::move(next);
     build();
@@ -426,8 +449,16 @@ class block_solver {
   void build() {
     n_ = layout_.block_cells;
     const std::size_t nleaf = std::size_t(tree_.size());
-    blocks_.resize(nleaf);
+    blocks_.assign(nleaf, block{});
     const index_t n2 = n_ * n_;
+    const index_t per_block = (n_ + 2 * ng) * (n_ + 2 * ng) * (n_ + 2 * ng);
+    stride_ = index_t(simd::padded(std::size_t(per_block))) + index_t(simd::width);
+    const index_t total = stride_ * index_t(nleaf);
+    U_ = std::make_unique<cons_storage>(total, 0.0);
+    U0_ = std::make_unique<cons_storage>(total, 0.0);
+    dU_ = std::make_unique<cons_storage>(total, 0.0);
+    W_ = std::make_unique<prim_storage>(total, 1.0);
+    S_.reset();
     for (std::size_t id = 0; id < nleaf; ++id) {
       block& b = blocks_[id];
       b.where = tree_.leaf(index_t(id));
@@ -446,21 +477,26 @@ class block_solver {
         b.boundary[std::size_t(2 * d + 1)] = !tree_.periodic(d) && b.where.l[du] + 1 == tree_.extent(d, b.where.level);
       }
       b.grid = rectilinear_grid(std::move(ax[0]), std::move(ax[1]), std::move(ax[2]));
-      const index_t N = b.grid.total_cells();
-      b.U.resize(N, 0.0);
-      b.U0.resize(N, 0.0);
-      b.dU.resize(N, 0.0);
-      b.W.resize(N, 1.0);
+      const index_t off = stride_ * index_t(id);
+      b.U = {U_.get(), off};
+      b.U0 = {U0_.get(), off};
+      b.dU = {dU_.get(), off};
+      b.W = {W_.get(), off};
       b.faces.assign(std::size_t(3 * 2 * 5 * n2), 0.0);
       b.bad_rows.assign(std::size_t(n2), 0);
-      if (sources_on_) b.sources.emplace(N, 0.0);
       setup_sponge(b);
     }
+    if (sources_on_) allocate_sources();
     plan_ = blocks::build_plan(tree_, n_);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
     U_all_.resize(nleaf);
     for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
+  }
+
+  void allocate_sources() {
+    S_ = std::make_unique<source_storage>(stride_ * block_count(), 0.0);
+    for (std::size_t id = 0; id < blocks_.size(); ++id) blocks_[id].sources = {S_.get(), stride_ * index_t(id)};
   }
 
   detail::face_register register_of(block& b, int axis) noexcept {
@@ -619,9 +655,9 @@ class block_solver {
     const auto U = detail::conserved_ptrs(std::as_const(b.U));
     detail::fields5<const double> src{};
     if (b.sources)
-      src = {b.sources->template get<field::s_rho>(), b.sources->template get<field::s_mx>(),
-             b.sources->template get<field::s_my>(), b.sources->template get<field::s_mz>(),
-             b.sources->template get<field::s_E>()};
+      src = {b.sources.template get<field::s_rho>(), b.sources.template get<field::s_mx>(),
+             b.sources.template get<field::s_my>(), b.sources.template get<field::s_mz>(),
+             b.sources.template get<field::s_E>()};
     const double* sig = b.sponge ? b.sponge->template get<field::sponge_sigma>() : nullptr;
     if (b.sources && sig) detail::add_sources<true, true>(b.grid, dU, U, src, sig, sponge_target_, false);
     else if (b.sources) detail::add_sources<true, false>(b.grid, dU, U, src, sig, sponge_target_, false);
@@ -707,6 +743,10 @@ class block_solver {
   long steps_ = 0;
   index_t n_ = 0;
   std::vector<block> blocks_;
+  index_t stride_ = 0;  ///< cells per block in the mesh-wide arrays
+  std::unique_ptr<cons_storage> U_, U0_, dU_;
+  std::unique_ptr<prim_storage> W_;
+  std::unique_ptr<source_storage> S_;  ///< null until enable_sources
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;

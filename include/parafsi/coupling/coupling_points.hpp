@@ -40,11 +40,13 @@ namespace parafsi::coupling {
 
 /// Eight-cell trilinear stencil of one point.
 struct stencil {
-  index_t base = 0;              ///< linear index of the (i0, j0, k0) corner cell
-  std::array<index_t, 3> ijk{};  ///< i0, j0, k0
-  std::array<double, 3> t{};     ///< fractions along each axis
-  double h = 0;                  ///< local cell size (cube root of the containing cell's volume)
-  bool inside = false;           ///< the point lies inside the box
+  index_t base = 0;               ///< linear index of the (i0, j0, k0) corner cell
+  std::array<index_t, 3> ijk{};   ///< i0, j0, k0
+  std::array<double, 3> t{};      ///< fractions along each axis
+  std::array<index_t, 8> cell{};  ///< the fluid cell of corner a (flat index of the fluid's arrays)
+  double h = 0;                   ///< local cell size (cube root of the containing cell's volume)
+  double hmin = 0;                ///< smallest width of the containing cell
+  bool inside = false;            ///< the point lies inside the box
   /// Weight of corner a (bit 0: +x, bit 1: +y, bit 2: +z).
   double weight(int a) const noexcept {
     return (a & 1 ? t[0] : 1.0 - t[0]) * (a & 2 ? t[1] : 1.0 - t[1]) * (a & 4 ? t[2] : 1.0 - t[2]);
@@ -69,6 +71,7 @@ class grid_locator {
   }
 
   const fluid::rectilinear_grid& grid() const noexcept { return *g_; }
+  double min_width() const noexcept { return g_->min_width(); }
   /// Linear offset of corner a from the stencil base.
   index_t corner(int a) const noexcept { return corner_[std::size_t(a)]; }
 
@@ -77,7 +80,7 @@ class grid_locator {
     const auto& g = *g_;
     stencil s;
     s.inside = true;
-    double vol = 1.0;
+    double vol = 1.0, hmin = 1e300;
     for (int d = 0; d < 3; ++d) {
       const index_t n = g.n(d);
       const double x = xi[d];
@@ -110,9 +113,12 @@ class grid_locator {
       index_t ic = std::clamp<index_t>(i0 + (t >= 0.5 ? 1 : 0), 0, n - 1);
       if (n == 1) ic = 0;
       vol *= g.width(d, ic);
+      if (n > 1) hmin = std::min(hmin, g.width(d, ic));
     }
     s.base = g.index(s.ijk[0], s.ijk[1], s.ijk[2]);
+    for (int a = 0; a < 8; ++a) s.cell[std::size_t(a)] = s.base + corner_[std::size_t(a)];
     s.h = std::cbrt(vol);
+    s.hmin = hmin < 1e300 ? hmin : g.min_width();
     return s;
   }
 
@@ -141,8 +147,9 @@ class coupling_points {
 
   /// Build NQUAD² points per triangle, NQUAD from the cell size at its centroid.
   /// `position(i)` gives node i's current position (inertial).
-  template <class Pos>
-  void build(const std::vector<std::array<index_t, 3>>& tris, Pos&& position, const grid_locator& loc,
+  /// `loc`: a locator (grid_locator, block_locator) with locate(ξ) and min_width().
+  template <class Pos, class Locator>
+  void build(const std::vector<std::array<index_t, 3>>& tris, Pos&& position, const Locator& loc,
              const frame::pose& pose, point_options opt = {}) {
     opt.validate();
     tris_ = tris;
@@ -152,13 +159,13 @@ class coupling_points {
     w_[2].clear();
     first_.assign(1, 0);
     nquad_.clear();
-    const double hmin = loc.grid().min_width();
+    const double hmin = loc.min_width();
     for (std::size_t e = 0; e < tris_.size(); ++e) {
       const auto& t = tris_[e];
       const Eigen::Vector3d x0 = position(t[0]), x1 = position(t[1]), x2 = position(t[2]);
       const double L = std::sqrt(std::max({(x1 - x0).squaredNorm(), (x2 - x1).squaredNorm(), (x0 - x2).squaredNorm()}));
       const stencil s = loc.locate(pose.to_box((x0 + x1 + x2) / 3.0));
-      const double h = s.inside ? std::min(s.h, local_min_width(loc.grid(), s)) : hmin;
+      const double h = s.inside ? std::min(s.h, s.hmin) : hmin;
       const int n = std::clamp(int(std::ceil(opt.points_per_cell * L / h - 1e-9)), 1, opt.max_nquad);
       nquad_.push_back(n);
       const double inv = 1.0 / n;
@@ -187,15 +194,6 @@ class coupling_points {
   const std::vector<std::array<index_t, 3>>& triangles() const noexcept { return tris_; }
 
  private:
-  static double local_min_width(const fluid::rectilinear_grid& g, const stencil& s) {
-    double h = 1e300;
-    for (int d = 0; d < 3; ++d) {
-      const index_t i = std::clamp<index_t>(s.ijk[std::size_t(d)] + (s.t[std::size_t(d)] >= 0.5), 0, g.n(d) - 1);
-      if (g.n(d) > 1) h = std::min(h, g.width(d, i));
-    }
-    return h < 1e300 ? h : g.min_width();
-  }
-
   std::vector<std::array<index_t, 3>> tris_;
   std::vector<index_t> elem_, first_;
   std::vector<int> nquad_;

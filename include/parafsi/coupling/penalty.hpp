@@ -61,6 +61,7 @@
 #include "../structure/assembly.hpp"
 #include "../structure/nodes.hpp"
 #include "coupling_points.hpp"
+#include "detail/fluid_mesh.hpp"
 #include "detail/membrane_coupling.hpp"
 #include "kinds.hpp"
 #include "porosity/impermeable.hpp"
@@ -153,7 +154,7 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
   template <class Fluid, class Asm>
   void attach(Fluid& f, Asm& s) {
     f.enable_sources();
-    loc_ = grid_locator(f.grid());
+    loc_ = mesh_locator::of(f);
     const std::vector<detail::triangle> tris = this->attach_triangles(s);
     const auto& nd = s.node_set();
     pts_.build(
@@ -188,24 +189,18 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
   template <class Fluid, class Asm>
   void exchange(Fluid& f, const Asm& s, double dt_f) {
     this->require_attached();
-    const auto& g = f.grid();
     // Fluid snapshot (inertial velocity, bulk modulus, density) on interior cells.
-    const index_t N = g.total_cells();
+    const index_t N = detail::cell_count(f);
     if (index_t(u_[0].size()) != N)
       for (auto* a : {&u_[0], &u_[1], &u_[2], &K_, &rho_}) a->assign(std::size_t(N), 0.0);
     const fluid::view fv = f.view();
-    const index_t nx = g.n(0), ny = g.n(1), nz = g.n(2);
-    parallel::for_range(0, ny * nz, [&](index_t row) {
-      const index_t base = g.index(0, row % ny, row / ny);
-      for (index_t i = 0; i < nx; ++i) {
-        const index_t c = base + i;
-        const Eigen::Vector3d u = fv.velocity(c);
-        u_[0][std::size_t(c)] = u.x();
-        u_[1][std::size_t(c)] = u.y();
-        u_[2][std::size_t(c)] = u.z();
-        K_[std::size_t(c)] = fv.bulk_modulus(c);
-        rho_[std::size_t(c)] = fv.density(c);
-      }
+    detail::for_each_interior_cell(f, [&](index_t c, double) {
+      const Eigen::Vector3d u = fv.velocity(c);
+      u_[0][std::size_t(c)] = u.x();
+      u_[1][std::size_t(c)] = u.y();
+      u_[2][std::size_t(c)] = u.z();
+      K_[std::size_t(c)] = fv.bulk_modulus(c);
+      rho_[std::size_t(c)] = fv.density(c);
     });
     // Clear the source arrays (they accumulate impulses until finish()).
     for (int q = 0; q < 4; ++q) {
@@ -237,7 +232,7 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
         }
         kraw[std::size_t(c)] = k;
         if (opt_.fluid_cap > 0)
-          for (int a = 0; a < 8; ++a) ksum_[std::size_t(sc.base + loc_.corner(a))] += sc.weight(a) * k;
+          for (int a = 0; a < 8; ++a) ksum_[std::size_t(sc.cell[std::size_t(a)])] += sc.weight(a) * k;
         // Travel relative to the grid over the step.
         const Eigen::Vector3d vs = point_velocity(geo, c);
         const Eigen::Vector3d wg = pose_.grid_velocity(pose_.to_box(x));
@@ -259,8 +254,8 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
       if (sc.inside && opt_.fluid_cap > 0) {
         for (int a = 0; a < 8; ++a) {
           if (sc.weight(a) <= 0) continue;
-          const index_t cell = sc.base + loc_.corner(a);
-          const double vol = g.cell_volume(cell);
+          const index_t cell = sc.cell[std::size_t(a)];
+          const double vol = detail::cell_volume(f, cell);
           const double ks = ksum_[std::size_t(cell)];
           if (ks > 0) sfac = std::min(sfac, opt_.fluid_cap * rho_[std::size_t(cell)] * vol / (dt_f * dt_f * ks));
         }
@@ -274,7 +269,7 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
     if (opt_.fluid_cap > 0)
       for (index_t c = 0; c < n; ++c)
         if (st[std::size_t(c)].inside)
-          for (int a = 0; a < 8; ++a) ksum_[std::size_t(st[std::size_t(c)].base + loc_.corner(a))] = 0.0;
+          for (int a = 0; a < 8; ++a) ksum_[std::size_t(st[std::size_t(c)].cell[std::size_t(a)])] = 0.0;
     // Structure-side substep limit (Gershgorin over free nodes).
     dt_struct_ = std::numeric_limits<double>::infinity();
     const double z = opt_.damping_ratio;
@@ -325,16 +320,10 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
   /// Turn the accumulated impulses into the fluid sources S = (J, W)/(Δt_f V_cell).
   template <class Fluid>
   void finish(Fluid& f, double dt_f) {
-    const auto& g = f.grid();
-    const index_t nx = g.n(0), ny = g.n(1), nz = g.n(2);
     const double inv_dt = 1.0 / dt_f;
-    parallel::for_range(0, ny * nz, [&](index_t row) {
-      const index_t j = row % ny, k = row / ny;
-      const index_t base = g.index(0, j, k);
-      for (index_t i = 0; i < nx; ++i) {
-        const double s = inv_dt / g.cell_volume(i, j, k);
-        for (int q = 0; q < 4; ++q) src_[std::size_t(q)][base + i] *= s;
-      }
+    detail::for_each_interior_cell(f, [&](index_t c, double vol) {
+      const double s = inv_dt / vol;
+      for (int q = 0; q < 4; ++q) src_[std::size_t(q)][c] *= s;
     });
   }
 
@@ -373,7 +362,7 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
         double K = 0, rho = 0;
         for (int a = 0; a < 8; ++a) {
           w[a] = sc.weight(a);
-          const std::size_t cell = std::size_t(sc.base + loc_.corner(a));
+          const std::size_t cell = std::size_t(sc.cell[std::size_t(a)]);
           vf += w[a] * Eigen::Vector3d(u_[0][cell], u_[1][cell], u_[2][cell]);
           K += w[a] * K_[cell];
           rho += w[a] * rho_[cell];
@@ -410,7 +399,7 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
         const Eigen::Vector3d J = -F * dt_kick;
         double wf = 0;
         for (int a = 0; a < 8; ++a) {
-          const std::size_t cell = std::size_t(sc.base + loc_.corner(a));
+          const std::size_t cell = std::size_t(sc.cell[std::size_t(a)]);
           const Eigen::Vector3d Jw = w[a] * J;
           sx[cell] += Jw.x();
           sy[cell] += Jw.y();
@@ -461,10 +450,10 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
   }
   double interp(const std::vector<double>& a, const stencil& s) const {
     double v = 0;
-    for (int q = 0; q < 8; ++q) v += s.weight(q) * a[std::size_t(s.base + loc_.corner(q))];
+    for (int q = 0; q < 8; ++q) v += s.weight(q) * a[std::size_t(s.cell[std::size_t(q)])];
     return v;
   }
-  grid_locator loc_;
+  mesh_locator loc_;
   coupling_points pts_;
   std::vector<double> d_, scale_, node_wsum_, node_k_, ksum_;
   std::array<std::vector<double>, 3> u_;

@@ -37,6 +37,7 @@
 #include "../core/soa.hpp"
 #include "blocks/exchange.hpp"
 #include "blocks/flux_correction.hpp"
+#include "blocks/layout.hpp"
 #include "blocks/refine.hpp"
 #include "blocks/tree.hpp"
 #include "boundary/condition.hpp"
@@ -57,29 +58,10 @@
 #include "solver.hpp"
 #include "time/ssp_rk2.hpp"
 #include "turbulence/none.hpp"
+#include "view.hpp"
 #include "viscosity/inviscid.hpp"
 
 namespace parafsi::fluid {
-
-/// The box and its blocks: [lo, hi] in box coordinates, the root grid of blocks, n cells
-/// per block edge.
-struct block_layout {
-  std::array<double, 3> lo{0, 0, 0}, hi{1, 1, 1};
-  std::array<index_t, 3> root_blocks{1, 1, 1};
-  index_t block_cells = 16;
-
-  void validate() const {
-    for (int d = 0; d < 3; ++d)
-      require(hi[std::size_t(d)] > lo[std::size_t(d)] && std::isfinite(lo[std::size_t(d)]) &&
-                  std::isfinite(hi[std::size_t(d)]),
-              "block_layout: need finite lo < hi on axis ", d);
-    blocks::check_block_size(block_cells);
-  }
-  /// Width of a block of level L along axis d.
-  double block_width(int d, int level) const noexcept {
-    return (hi[std::size_t(d)] - lo[std::size_t(d)]) / double(root_blocks[std::size_t(d)] << level);
-  }
-};
 
 template <class Flux = flux::hllc_lm, class Recon = recon::muscl<limiter::van_leer>,
           class Turbulence = turbulence::none, class Viscosity = viscosity::inviscid, class Frame = frame::fixed,
@@ -216,22 +198,9 @@ class block_solver {
 
   /// The leaf and cell holding the point ξ (box coordinates); {−1, 0} outside the box.
   std::pair<index_t, index_t> locate(const Eigen::Vector3d& xi) const {
-    const int top = tree_.finest_level();
-    std::array<std::int64_t, 3> l{};
-    for (int d = 0; d < 3; ++d) {
-      const double u = (xi[d] - layout_.lo[std::size_t(d)]) / layout_.block_width(d, top);
-      if (!(u >= 0.0 && u < double(tree_.extent(d, top)))) return {-1, 0};
-      l[std::size_t(d)] = std::int64_t(std::floor(u));
-    }
-    const blocks::cover c = tree_.find({top, l});
-    if (c.kind != blocks::cover::leaf) return {-1, 0};
-    const block& b = blocks_[std::size_t(c.id)];
-    index_t ijk[3];
-    for (int d = 0; d < 3; ++d) {
-      const double h = layout_.block_width(d, b.where.level) / double(n_);
-      ijk[d] = std::clamp<index_t>(index_t(std::floor((xi[d] - b.grid.face(d, 0)) / h)), 0, n_ - 1);
-    }
-    return {c.id, b.grid.index(ijk[0], ijk[1], ijk[2])};
+    const blocks::cell_address a = blocks::find_cell(tree_, layout_, xi);
+    if (a.block < 0) return {-1, 0};
+    return {a.block, blocks_[std::size_t(a.block)].grid.index(a.ijk[0], a.ijk[1], a.ijk[2])};
   }
   /// Primitive state of the leaf cell holding ξ.
   prim<double> sample(const Eigen::Vector3d& xi) const {
@@ -286,6 +255,20 @@ class block_solver {
   index_t global_index(index_t id, index_t cell) const noexcept { return id * stride_ + cell; }
   /// The mesh-wide conserved storage (block id at id · stride()).
   const cons_storage& conserved_storage() const noexcept { return *U_; }
+
+  /// Mesh-wide source array (global_index): component 0–2 momentum, 3 energy, 4 mass.
+  double* source(int component) { return source(0, component); }
+  /// Read-only view of the state over the mesh-wide arrays: cells are global indices
+  /// (global_index); the view's grid is null (a block's grid is block_at(id).grid).
+  fluid::view view() const noexcept {
+    fluid::view v = fluid::view::of(blocks_[0].grid, pose_, gas_, *U_);
+    v.grid = nullptr;
+    return v;
+  }
+  /// Volume of the cell at a global index.
+  double cell_volume(index_t global) const noexcept {
+    return blocks_[std::size_t(global / stride_)].grid.cell_volume(global % stride_);
+  }
 
   /// Sponge rate σ of a leaf cell (0 outside the layer).
   double sponge_rate(index_t id, index_t cell) const noexcept {

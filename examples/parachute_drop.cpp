@@ -139,6 +139,22 @@ int main(int argc, char** argv) {
   app.add_option("--cell", c.cell, "override: fluid cell size around the canopy / D0")
       ->check(finite)
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option_function<double>(
+         "--finest-cell", [&c](double n) { c.cell = 1.0 / n; },
+         "override: fluid cell size around the canopy as a fraction of D0, e.g. 30 for D0/30 (same as --cell 1/N)")
+      ->check(finite)
+      ->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--mesh", c.mesh,
+                 "fluid mesh: tensor (the refined rectilinear box) or blocks (block-structured, refined to the "
+                 "canopy; penalty coupling only so far)")
+      ->check(CLI::IsMember({"tensor", "blocks"}))
+      ->capture_default_str();
+  app.add_option("--block-size", c.block_size, "blocks: cells per block edge (even, 4-64)")
+      ->check(CLI::Range(4, 64))
+      ->capture_default_str();
+  app.add_option("--refine-every", c.refine_every, "blocks: regrid to the canopy every this many steps")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   app.add_option("--element", c.element, "override: canopy element size / D0")
       ->check(finite)
       ->check(CLI::Range(0.0, 1.0));

@@ -60,6 +60,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -89,6 +90,9 @@ struct drop_config {
   std::string fabric = "mat544";      ///< paper canopy: mat544 | mat59225 | mat509
   std::string resolution = "coarse";  ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
   std::string coupling = "embedded";  ///< embedded | penalty
+  std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh (penalty only)
+  int block_size = 8;                 ///< blocks: cells per block edge
+  int refine_every = 5;               ///< blocks: regrid to the canopy every this many steps
   std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
   double t_end = 6.0;                 ///< simulated time (s)
   double history_every = 0.005;       ///< output interval (s)
@@ -131,6 +135,17 @@ struct drop_config {
     require(one_of(packed, {"scene", "reduced_radius", "star_fold", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
+    require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
+    if (mesh == "blocks") {
+      require(coupling == "penalty",
+              "parachute_drop: --mesh blocks runs the penalty coupling only so far (the "
+              "embedded coupling's face patches are not on the block mesh yet); add --coupling penalty");
+      require(viscosity != "constant", "parachute_drop: --mesh blocks is inviscid so far (no --viscosity constant)");
+      require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
+              "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
+      require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
+      require(vtk_every == 0, "parachute_drop: --vtk-every with --mesh blocks is not available yet");
+    }
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
                                                       {"force_cutoff", force_cutoff},
@@ -278,7 +293,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
   const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
-  su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
+  su.viscous = c.mesh != "blocks" && !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
 }
 
@@ -301,6 +316,10 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
   g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
   g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
+  if (c.mesh == "blocks")
+    g.add("mesh", c.mesh)
+        .add("block_size", std::int64_t(c.block_size))
+        .add("refine_every", std::int64_t(c.refine_every));
   return g;
 }
 
@@ -312,9 +331,13 @@ template <class Fluid, class Coupling>
 class drop_run {
  public:
   using stepper_type = explicit_stepper<Fluid, structure::drop_assembly, Coupling, drop_frame_target_t<Fluid>>;
+  static constexpr bool block_mesh = coupling::block_fluid<Fluid>;
 
-  drop_run(const drop_config& c, const drop_setup& su, Fluid&& f, structure::drop_assembly&& a, Coupling&& cpl)
-      : c_(c),
+  /// `levels`: the block mesh's finest level (block meshes only).
+  drop_run(const drop_config& c, const drop_setup& su, Fluid&& f, structure::drop_assembly&& a, Coupling&& cpl,
+           int levels = 0)
+      : levels_(levels),
+        c_(c),
         su_(su),
         s_(std::move(f), std::move(a), std::move(cpl), drop_frame_target<Fluid>(su.params.gravity)),
         observe_(su.scene),
@@ -334,18 +357,30 @@ class drop_run {
     if (!c_.restart.empty()) res.history = restart();
     open_outputs();
     emit(false);  // carried rows: those whose filter window is complete
-    const auto& g = s_.fluid().grid();
-    res.cells = long(g.n(0)) * g.n(1) * g.n(2);
+    if constexpr (block_mesh) {
+      if (c_.restart.empty()) regrid();
+      res.cells = long(s_.fluid().cell_count());
+    } else {
+      const auto& g = s_.fluid().grid();
+      res.cells = long(g.n(0)) * g.n(1) * g.n(2);
+    }
     res.nodes = long(nd.size());
     res.triangles = long(su_.scene.triangles.size());
     res.fabric = std::string(su_.scene.fabric.name);
-    if (!c_.quiet)
+    if (!c_.quiet) {
+      char mesh[160];
+      if constexpr (block_mesh)
+        std::snprintf(mesh, sizeof mesh, "%ld blocks of %d^3, levels 0-%d", long(s_.fluid().block_count()),
+                      c_.block_size, levels_);
+      else
+        std::snprintf(mesh, sizeof mesh, "%ldx%ldx%ld", long(s_.fluid().grid().n(0)), long(s_.fluid().grid().n(1)),
+                      long(s_.fluid().grid().n(2)));
       std::fprintf(stderr,
-                   "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%ldx%ldx%ld, h = %.4g m near the canopy), "
+                   "parachute_drop: %s canopy, %s, %s: %ld fluid cells (%s, h = %.4g m near the canopy), "
                    "%ld structure nodes, %zu triangles, coupling %s, %s box, PGS alpha %g, t_end %.3g s\n",
-                   su_.params.name.c_str(), res.fabric.c_str(), c_.resolution.c_str(), res.cells, long(g.n(0)),
-                   long(g.n(1)), long(g.n(2)), su_.box.cell, res.nodes, su_.scene.triangles.size(), c_.coupling.c_str(),
-                   c_.box.c_str(), su_.alpha, c_.t_end);
+                   su_.params.name.c_str(), res.fabric.c_str(), c_.resolution.c_str(), res.cells, mesh, su_.box.cell,
+                   res.nodes, su_.scene.triangles.size(), c_.coupling.c_str(), c_.box.c_str(), su_.alpha, c_.t_end);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     long substeps = 0;
     try {
@@ -419,6 +454,8 @@ class drop_run {
     }
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
+      if constexpr (block_mesh)
+        if (s_.steps() % c_.refine_every == 0) regrid();
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
       s_.step(dt);
@@ -445,7 +482,7 @@ class drop_run {
     // The checkpoint holds the fluid, not the far field: a run restarted with another α
     // (or scene pressure) would put the restored air against a different ambient (the
     // signature names α; this guards a scene pressure that is not in it).
-    const double q = s_.fluid().primitive(0, 0, 0).p, q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
+    const double q = corner_pressure(), q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
     require(q > 0.5 * q_inf && q < 2.0 * q_inf, "parachute_drop: checkpoint '", c_.restart, "' holds air at ", q,
             " Pa in a corner cell, but this run's ambient is ", q_inf, " Pa (PGS alpha ", su_.alpha,
             "): restart with the --pgs and scene of the run that wrote it");
@@ -505,7 +542,7 @@ class drop_run {
       io::write_vtu(fs, s_.structure());
       io::vtk_options vo;
       vo.pressure_offset = p_offset_;
-      io::write_vts(ff, s_.fluid(), vo);
+      if constexpr (!block_mesh) io::write_vts(ff, s_.fluid(), vo);
       pvd_->add(s_.time(), ff, 0);
       pvd_->add(s_.time(), fs, 1);
       next_vtk_ += c_.vtk_every;
@@ -519,6 +556,26 @@ class drop_run {
   void write_slice(double t_label) {
     io::write_drop_slice(out(), t_label, s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
                          structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
+  }
+
+  /// Block mesh: refine to the canopy's current place (drop_block_target).
+  void regrid() {
+    if constexpr (block_mesh)
+      s_.fluid().regrid(drop_block_target(s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
+                                          su_.scene.triangles, levels_, c_.refine_every),
+                        levels_);
+  }
+
+  /// Pressure of a corner cell of the box (the restart's check of the ambient).
+  double corner_pressure() const {
+    if constexpr (block_mesh) {
+      const auto& b = s_.fluid().block_at(0);
+      return to_prim(fluid::detail::load_cons(fluid::detail::conserved_ptrs(b.U), b.grid.index(0, 0, 0)),
+                     s_.fluid().gas())
+          .p;
+    } else {
+      return s_.fluid().primitive(0, 0, 0).p;
+    }
   }
 
   /// The stable step, refused when it collapses, shortened to land on `target`.
@@ -545,6 +602,7 @@ class drop_run {
                               -1, s_.time());
   }
 
+  int levels_ = 0;  ///< block mesh: the finest level
   const drop_config& c_;
   const drop_setup& su_;
   stepper_type s_;
@@ -596,11 +654,29 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   bc.layer = {3, 0.5};
   return detail::with_fluid_policies(su, [&](auto visc, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
+    const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
+    if constexpr (std::is_same_v<decltype(visc), viscosity::inviscid>) {
+      if (c.mesh == "blocks") {
+        // The block mesh: one level to start with, refined to the canopy before the first step.
+        const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
+        fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc, flux::hllc_lm{},
+                               recon::muscl<limiter::van_leer>{},    frame};
+        fl.fill_uniform(air);
+        place_drop_box(fl, su.box, chute);
+        if (parallel::max_threads() > 1) fl.set_threading(true);
+        coupling::penalty_options po;
+        po.pfac = c.pfac;
+        po.stiffening = c.stiffening;
+        po.damping_ratio = c.coupling_damping;
+        using C = coupling::penalty<porosity::ergun>;
+        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
+        return run.run(progress);
+      }
+    }
     fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, frame};
     fl.initialize([&](const Eigen::Vector3d&) { return air; });
     place_drop_box(fl, su.box, chute);
     if (parallel::max_threads() > 1) fl.set_threading(true);
-    const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
     auto go = [&](auto cpl) -> drop_result {
       detail::drop_run<decltype(fl), decltype(cpl)> run{c, su, std::move(fl), std::move(chute), std::move(cpl)};
       return run.run(progress);

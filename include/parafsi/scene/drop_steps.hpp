@@ -3,17 +3,26 @@
 /// (examples/drop_guide.cpp) shares with scene::run_drop (scene/drop.hpp):
 ///
 ///   make_drop_grid(box)               the rectilinear grid of a model::drop_box
+///   make_drop_blocks(box, n)          its block-mesh layout and finest level (--mesh blocks)
+///   drop_block_target(...)            the block mesh's refinement target: the canopy
 ///   place_drop_box(fluid, box, chute) the box pose: axes, payload mass centre, velocity
 ///   drop_frame_target<Fluid>(g)       the stepper's frame target: the payload's mass centre
 ///   landing_step(dt, left)            a step shortened to land on an output instant
 ///
 /// The box motion itself is planned by the stepper (move_frame phase) from the frame target.
 #pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "../fluid/blocks/layout.hpp"
+#include "../fluid/blocks/refine.hpp"
 #include "../fluid/grid.hpp"
 #include "../frame_target.hpp"
 #include "../model/drop_box.hpp"
@@ -27,6 +36,56 @@ inline fluid::rectilinear_grid make_drop_grid(const model::drop_box& b) {
     return fluid::axis::refined(b.lo[d], b.hi[d], b.fine_lo[d], b.fine_hi[d], b.cell, b.growth);
   };
   return fluid::rectilinear_grid{axis(0), axis(1), axis(2)};
+}
+
+/// The block mesh of the box `b` with n cells per block edge: the finest cell is the box's
+/// refined cell h, and L levels above the root grid with L the largest that leaves at least
+/// two root blocks (n 2^L h wide) across the narrowest side; the root blocks tile a box
+/// grown about the same centre to whole blocks (every axis keeps cubic cells). Returns the
+/// layout and L.
+inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_box& b, int n) {
+  const double h = b.cell;
+  double narrow = 1e300;
+  for (std::size_t d = 0; d < 3; ++d) narrow = std::min(narrow, b.hi[d] - b.lo[d]);
+  const int L = std::max(0, int(std::floor(std::log2(narrow / (2.0 * n * h)))));
+  require(L <= fluid::blocks::tree::max_depth, "scene::make_drop_blocks: ", L, " levels are too many");
+  const double root = double(n) * h * std::ldexp(1.0, L);
+  fluid::block_layout lay;
+  lay.block_cells = n;
+  for (std::size_t d = 0; d < 3; ++d) {
+    const index_t nb = std::max<index_t>(1, index_t(std::ceil((b.hi[d] - b.lo[d]) / root - 1e-9)));
+    require(nb <= fluid::blocks::tree::max_root, "scene::make_drop_blocks: ", nb, " root blocks on an axis, more than ",
+            fluid::blocks::tree::max_root);
+    const double mid = 0.5 * (b.lo[d] + b.hi[d]);
+    lay.root_blocks[d] = nb;
+    lay.lo[d] = mid - 0.5 * double(nb) * root;
+    lay.hi[d] = mid + 0.5 * double(nb) * root;
+  }
+  return {lay, L};
+}
+
+/// The block mesh's refinement target for a drop: the finest level `level` within a buffer of
+/// the canopy's nodes (box coordinates of fluid `f`'s pose), graded outwards (each coarser
+/// level twice as far). The buffer is the canopy's longest element edge now plus
+/// (refine_every + 2) finest cells: a node moves at most one cell per step relative to the
+/// box (the coupling's travel limit), so until the next regrid every cell the canopy cuts,
+/// with its interpolation stencil, stays on the finest level.
+template <class Fluid>
+fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f, const structure::nodes& nd,
+                                                                  index_t canopy_nodes,
+                                                                  const std::vector<std::array<index_t, 3>>& tris,
+                                                                  int level, int refine_every) {
+  const auto& lay = f.layout();
+  const Eigen::Matrix3d Rt = f.pose().R.transpose();
+  std::vector<Eigen::Vector3d> pts;
+  pts.reserve(std::size_t(canopy_nodes));
+  for (index_t i = 0; i < canopy_nodes; ++i) pts.push_back(Rt * (nd.position(i) - f.pose().X));
+  double edge = 0;
+  for (const auto& t : tris)
+    for (int a = 0; a < 3; ++a)
+      edge = std::max(edge, (nd.position(t[std::size_t(a)]) - nd.position(t[std::size_t((a + 1) % 3)])).norm());
+  const double h = std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
+  return {lay, std::move(pts), edge + double(refine_every + 2) * h, level, true};
 }
 
 /// Place the box `b` of fluid `f` at the payload of `a`: R = the box axes, X = the payload

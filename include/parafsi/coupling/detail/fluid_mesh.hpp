@@ -88,12 +88,22 @@ class block_locator {
       vol *= h;
       hmin = std::min(hmin, h);
     }
+    const fluid::blocks::location& hb = tree_->leaf(home.block);
     for (int a = 0; a < 8; ++a) {
-      Eigen::Vector3d c;
+      std::array<index_t, 3> G{};
+      bool own = true;  // the corner cell lies in the point's own block: no search
       for (int d = 0; d < 3; ++d) {
-        const index_t g = i0[std::size_t(d)] + ((a >> d) & 1);
-        c[d] = lay_.lo[std::size_t(d)] + (double(g) + 0.5) * lay_.cell_width(d, L);
+        G[std::size_t(d)] = i0[std::size_t(d)] + ((a >> d) & 1);
+        const index_t loc = G[std::size_t(d)] - hb.l[std::size_t(d)] * n;
+        own = own && loc >= 0 && loc < n;
       }
+      if (own) {
+        s.cell[std::size_t(a)] = global({home.block, L, {G[0] - hb.l[0] * n, G[1] - hb.l[1] * n, G[2] - hb.l[2] * n}});
+        continue;
+      }
+      Eigen::Vector3d c;
+      for (int d = 0; d < 3; ++d)
+        c[d] = lay_.lo[std::size_t(d)] + (double(G[std::size_t(d)]) + 0.5) * lay_.cell_width(d, L);
       const fluid::blocks::cell_address ca = fluid::blocks::find_cell(*tree_, lay_, c);
       s.cell[std::size_t(a)] = ca.block < 0 ? global(home) : global(ca);
     }

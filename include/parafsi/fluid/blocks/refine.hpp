@@ -2,9 +2,11 @@
 /// Refinement criteria for the block mesh: `target(location) → level` functions for
 /// tree::refine_where and block_solver::regrid.
 ///
-///   near_points{layout, points, buffer, level}: `level` for every block whose box comes
-///     within `buffer` (m, box coordinates) of one of the points, 0 elsewhere (the 2:1
-///     balance grades the levels in between). With the structure's nodes as points and a
+///   near_points{layout, points, buffer, level, graded}: `level` for every block whose box
+///     comes within `buffer` (m, box coordinates) of one of the points; elsewhere 0, or with
+///     `graded` the level ℓ < level within buffer · 2^(level − ℓ) (each coarser level twice
+///     as far out), so a feature near the points (a canopy's near wake) keeps cells that
+///     coarsen gradually; the 2:1 balance grades whatever remains. With the structure's nodes as points and a
 ///     buffer of at least the longest element edge plus the distance the structure can
 ///     travel between regrids plus two finest cells (the prolongation and MUSCL
 ///     stencils), every cell a membrane cuts, and its stencil, is on the finest level
@@ -56,8 +58,8 @@ inline double distance(const block_box& b, const Eigen::Vector3d& p) {
 template <class Layout>
 class near_points {
  public:
-  near_points(const Layout& lay, std::vector<Eigen::Vector3d> points, double buffer, int level)
-      : lay_(lay), pts_(std::move(points)), buffer_(buffer), level_(level) {
+  near_points(const Layout& lay, std::vector<Eigen::Vector3d> points, double buffer, int level, bool graded = false)
+      : lay_(lay), pts_(std::move(points)), buffer_(buffer), level_(level), graded_(graded) {
     require(std::isfinite(buffer) && buffer >= 0, "blocks::near_points: buffer must be finite and >= 0, got ", buffer);
     require(level >= 0 && level <= tree::max_depth, "blocks::near_points: level must be in [0, ", tree::max_depth,
             "], got ", level);
@@ -68,14 +70,21 @@ class near_points {
     for (std::size_t i = 0; i < pts_.size(); ++i) bins_[key(bin_of(pts_[i]))].push_back(i);
   }
 
-  int operator()(const location& q) const { return near(box_of(lay_, q)) ? level_ : 0; }
+  int operator()(const location& q) const {
+    const block_box b = box_of(lay_, q);
+    if (near(b, buffer_)) return level_;
+    if (graded_)
+      for (int l = level_ - 1; l >= 1; --l)
+        if (near(b, std::ldexp(buffer_, level_ - l))) return l;
+    return 0;
+  }
 
-  /// Whether some point lies within the buffer of the box.
-  bool near(const block_box& b) const {
+  /// Whether some point lies within distance r of the box.
+  bool near(const block_box& b, double r) const {
     std::array<std::int64_t, 3> a{}, z{};
     for (int d = 0; d < 3; ++d) {
-      a[std::size_t(d)] = std::int64_t(std::floor((b.lo[std::size_t(d)] - buffer_) / bin_));
-      z[std::size_t(d)] = std::int64_t(std::floor((b.hi[std::size_t(d)] + buffer_) / bin_));
+      a[std::size_t(d)] = std::int64_t(std::floor((b.lo[std::size_t(d)] - r) / bin_));
+      z[std::size_t(d)] = std::int64_t(std::floor((b.hi[std::size_t(d)] + r) / bin_));
     }
     for (std::int64_t k = a[2]; k <= z[2]; ++k)
       for (std::int64_t j = a[1]; j <= z[1]; ++j)
@@ -83,7 +92,7 @@ class near_points {
           const auto it = bins_.find(key({i, j, k}));
           if (it == bins_.end()) continue;
           for (std::size_t p : it->second)
-            if (distance(b, pts_[p]) <= buffer_) return true;
+            if (distance(b, pts_[p]) <= r) return true;
         }
     return false;
   }
@@ -103,6 +112,7 @@ class near_points {
   std::vector<Eigen::Vector3d> pts_;
   double buffer_;
   int level_;
+  bool graded_;
   double bin_ = 0;
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins_;
 };

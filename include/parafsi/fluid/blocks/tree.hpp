@@ -101,11 +101,7 @@ class tree {
   const std::vector<location>& leaves() const noexcept { return order_; }
   std::array<index_t, 3> root_blocks() const noexcept { return nb_; }
   bool periodic(int d) const noexcept { return periodic_[std::size_t(d)]; }
-  int finest_level() const noexcept {
-    int m = 0;
-    for (const auto& q : order_) m = std::max(m, q.level);
-    return m;
-  }
+  int finest_level() const noexcept { return finest_; }
   /// Blocks per axis at level L.
   index_t extent(int d, int level) const noexcept { return nb_[std::size_t(d)] << level; }
   bool is_leaf(const location& q) const { return leaves_.count(key(q)) != 0; }
@@ -242,7 +238,11 @@ class tree {
       return ma != mb ? ma < mb : a.level < b.level;
     });
     ids_.clear();
-    for (std::size_t i = 0; i < order_.size(); ++i) ids_.emplace(key(order_[i]), index_t(i));
+    finest_ = 0;
+    for (std::size_t i = 0; i < order_.size(); ++i) {
+      ids_.emplace(key(order_[i]), index_t(i));
+      finest_ = std::max(finest_, order_[i].level);
+    }
   }
 
   std::array<index_t, 3> nb_{1, 1, 1};
@@ -250,6 +250,7 @@ class tree {
   std::unordered_map<std::uint64_t, location> leaves_;
   std::unordered_map<std::uint64_t, index_t> ids_;
   std::vector<location> order_;
+  int finest_ = 0;
 };
 
 }  // namespace parafsi::fluid::blocks

@@ -1,6 +1,7 @@
-// Observers: VTK XML writers (structure .vtu, fluid .vts, .pvd) and mid-plane slices.
+// Observers: VTK XML writers (structure .vtu, fluid .vts, block mesh .vtu, .pvd) and mid-plane slices.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include <parafsi/fluid/fluid.hpp>
+#include <parafsi/io/block_vtk.hpp>
 #include <parafsi/io/vtk.hpp>
 #include <parafsi/structure/structure.hpp>
 
@@ -360,6 +362,156 @@ TEST_CASE("vts: eddy viscosity is written when the solver has a closure") {
   io::write_vts(p, s, {io::vtk_encoding::ascii});
   const auto doc = parse_xml(slurp(p));
   CHECK(values(doc->kids[0]->child("StructuredGrid")->child("Piece")->array("eddy_viscosity")).size() == 24);
+}
+
+namespace {
+/// Signed volume of a VTK hexahedron (points 0–3 the lower face counter-clockwise seen from
+/// above, 4–7 above them): six tetrahedra around the diagonal 0–6.
+double hex_volume(const std::array<Eigen::Vector3d, 8>& p) {
+  auto tet = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                const Eigen::Vector3d& d) { return (b - a).dot((c - a).cross(d - a)) / 6.0; };
+  return tet(p[0], p[1], p[2], p[6]) + tet(p[0], p[2], p[3], p[6]) + tet(p[0], p[3], p[7], p[6]) +
+         tet(p[0], p[7], p[4], p[6]) + tet(p[0], p[4], p[5], p[6]) + tet(p[0], p[5], p[1], p[6]);
+}
+
+/// A 2×2×2-block box on a turned pose with the block at (0, 1, 0) refined once (two
+/// levels), filled with a solid rotation u = Ω × (x − x0), a density linear in box y and a
+/// pressure varying along box x.
+struct two_level_mesh {
+  static constexpr index_t n = 4;
+  const Eigen::Vector3d Omega{0.3, -1.2, 2.0}, centre{9.0, -1.0, 3.5};
+  fluid::block_solver<> s{[] {
+    fluid::blocks::tree t({2, 2, 2});
+    t.refine(fluid::blocks::location{0, {0, 1, 0}});
+    return t;
+                          }(),
+                          fluid::block_layout{{-1.0, -0.6, 0.0}, {1.0, 0.6, 1.0}, {2, 2, 2}, n},
+                          boundary::set::all(boundary::far_field{})};
+  two_level_mesh() {
+    s.pose().X = {10.0, -2.0, 3.0};
+    s.pose().R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    s.set_time(0.125);
+    s.initialize([&](const Eigen::Vector3d& xi) {
+      const Eigen::Vector3d u = Omega.cross(s.pose().to_inertial(xi) - centre);
+      return fluid::prim<double>{1.2 + 0.1 * xi.y(), {u.x(), u.y(), u.z()}, 1e5 + 100.0 * xi.x()};
+    });
+  }
+};
+}  // namespace
+
+TEST_CASE(
+    "block vtu: one hexahedron per leaf cell, shared corners, volumes sum to the box, values round-trip, vorticity "
+    "2 Omega across levels") {
+  two_level_mesh m;
+  const auto& s = m.s;
+  REQUIRE(s.tree().finest_level() == 1);
+  REQUIRE(s.block_count() == 15);  // 7 root blocks + 8 children
+  const auto w = io::vorticity(s);
+  REQUIRE(w.size() == 3 * std::size_t(s.cell_count()));
+  for (std::size_t c = 0; c < w.size() / 3; ++c)
+    for (int d = 0; d < 3; ++d) CHECK(w[3 * c + std::size_t(d)] == doctest::Approx(2 * m.Omega[d]).epsilon(1e-11));
+  const double box_volume = 2.0 * 1.2 * 1.0;
+  for (auto enc : {io::vtk_encoding::ascii, io::vtk_encoding::binary}) {
+    const fs::path p = scratch(enc == io::vtk_encoding::ascii ? "b_ascii.vtu" : "b_bin.vtu");
+    io::write_vtu(p, s, {enc, 250.0});
+    CHECK_FALSE(fs::exists(p.string() + ".tmp"));
+    const auto doc = parse_xml(slurp(p));
+    const node* ug = doc->kids[0]->child("UnstructuredGrid");
+    REQUIRE(ug);
+    CHECK(values(ug->child("FieldData")->child("DataArray")) == std::vector<double>{0.125});
+    const node* piece = ug->child("Piece");
+    const std::size_t cells = std::size_t(s.cell_count());
+    CHECK(std::stoul(piece->attr.at("NumberOfCells")) == cells);
+    const auto pts = values(piece->child("Points")->child("DataArray"));
+    const auto conn = values(piece->array("connectivity")), offs = values(piece->array("offsets"));
+    const auto types = values(piece->array("types"));
+    REQUIRE(std::stoul(piece->attr.at("NumberOfPoints")) * 3 == pts.size());
+    REQUIRE(conn.size() == 8 * cells);
+    REQUIRE(offs.size() == cells);
+    CHECK(std::count(types.begin(), types.end(), 12.0) == std::ptrdiff_t(cells));
+    // Corners written once: no two points coincide. Unique corners of the leaves: the
+    // root lattice (2·4+1)³ plus the refined block's lattice (9³) less its 5³ coarse ones.
+    std::vector<std::array<double, 3>> sorted;
+    for (std::size_t q = 0; q < pts.size(); q += 3) sorted.push_back({pts[q], pts[q + 1], pts[q + 2]});
+    std::sort(sorted.begin(), sorted.end());
+    CHECK(std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end());
+    CHECK(sorted.size() == std::size_t(9 * 9 * 9 + 9 * 9 * 9 - 5 * 5 * 5));
+    const auto rho = values(piece->array("density")), vel = values(piece->array("velocity"));
+    const auto pr = values(piece->array("pressure")), vo = values(piece->array("vorticity"));
+    const auto lev = values(piece->array("level")), blk = values(piece->array("block"));
+    REQUIRE(rho.size() == cells);
+    REQUIRE(vo.size() == 3 * cells);
+    double volume = 0, min_ratio = 1e300, max_ratio = 0;
+    std::size_t mismatches = 0, fine = 0;
+    for (std::size_t c = 0; c < cells; ++c) {
+      CHECK(offs[c] == double(8 * (c + 1)));
+      std::array<Eigen::Vector3d, 8> corner;
+      Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+      for (int v = 0; v < 8; ++v) {
+        const std::size_t q = std::size_t(conn[8 * c + std::size_t(v)]);
+        corner[std::size_t(v)] = {pts[3 * q], pts[3 * q + 1], pts[3 * q + 2]};
+        mid += corner[std::size_t(v)] / 8.0;
+      }
+      const double vol = hex_volume(corner);
+      volume += vol;
+      // The cell the written corners enclose holds the written values and is the written block.
+      const Eigen::Vector3d xi = s.pose().to_box(mid);
+      const auto [id, cell] = s.locate(xi);
+      const auto& g = s.block_at(id).grid;
+      const auto ijk = g.ijk(cell);
+      const double ratio = vol / g.cell_volume(ijk[0], ijk[1], ijk[2]);
+      min_ratio = std::min(min_ratio, ratio);
+      max_ratio = std::max(max_ratio, ratio);
+      const auto wp = s.sample(xi);
+      const bool same = blk[c] == double(id) && lev[c] == double(s.block_at(id).where.level) && rho[c] == wp.rho &&
+                        pr[c] == wp.p + 250.0 && vel[3 * c] == wp.u.x && vel[3 * c + 1] == wp.u.y &&
+                        vel[3 * c + 2] == wp.u.z && vo[3 * c + 2] == w[3 * c + 2];
+      mismatches += same ? 0 : 1;
+      fine += lev[c] == 1.0 ? 1 : 0;
+    }
+    MESSAGE("block vtu: ", cells, " cells (", fine, " on level 1), ", sorted.size(), " points, volume ", volume);
+    CHECK(mismatches == 0);
+    CHECK(fine == 8 * 64);
+    CHECK(volume == doctest::Approx(box_volume).epsilon(1e-12));
+    CHECK(min_ratio == doctest::Approx(1.0).epsilon(1e-12));  // every hexahedron right-handed, its cell's volume
+    CHECK(max_ratio == doctest::Approx(1.0).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("block mid-plane CSV: one row per cut leaf cell, on the plane, exact for fields linear along the normal") {
+  two_level_mesh m;
+  const auto& s = m.s;
+  const fs::path mp = scratch("block_mid.csv");
+  // Normal box y through ξ_y = 0: the plane is the lower face of the upper blocks, one of
+  // them refined, so rows come from 3 coarse blocks (n² cells each) and 4 fine ones.
+  const std::size_t rows = io::write_midplane_csv(mp, s);
+  CHECK(rows == std::size_t(7 * two_level_mesh::n * two_level_mesh::n));
+  std::ifstream in(mp);
+  std::string line;
+  std::getline(in, line);
+  CHECK(line == "x,y,z,rho,u,v,w,p,vorticity_normal");
+  std::size_t count = 0;
+  const Eigen::Vector3d ny = s.pose().R.col(1);
+  double max_rho_err = 0, max_om_err = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));
+    REQUIRE(v.size() == 9);
+    const Eigen::Vector3d xi = s.pose().to_box({v[0], v[1], v[2]});
+    CHECK(xi[1] == doctest::Approx(0.0).scale(1.0));  // on the plane
+    max_rho_err = std::max(max_rho_err, std::abs(v[3] - 1.2));
+    max_om_err = std::max(max_om_err, std::abs(v[8] - 2 * m.Omega.dot(ny)));
+    ++count;
+  }
+  MESSAGE("block mid-plane: ", rows, " rows, density error ", max_rho_err, ", normal vorticity error ", max_om_err);
+  CHECK(count == rows);
+  CHECK(max_rho_err < 1e-9);  // ρ = 1.2 + 0.1 ξ_y interpolated to ξ_y = 0 (10 digits written)
+  CHECK(max_om_err < 1e-8);
+  // An off-centre plane normal to box x at ξ_x = 0.3 cuts the fine block's layer too.
+  CHECK(io::write_midplane_csv(mp, s, {0, -0.3}) == std::size_t(3 * 16 + 4 * 16));
+  CHECK_THROWS_AS(io::write_midplane_csv(mp, s, {3}), invalid_input);
+  CHECK_THROWS_WITH_AS(io::write_midplane_csv(mp, s, {1, 5.0}), doctest::Contains("outside the box"), invalid_input);
 }
 
 TEST_CASE("pvd: entries appended, collection always complete, resume keeps entries up to the restart time") {

@@ -7,6 +7,7 @@
 ///   write_vts(path, solver)          fluid     → StructuredGrid (.vts)
 ///   write_midplane_csv(path, solver) fluid mid-plane slice → CSV
 ///   pvd_writer                       time series (.pvd) of any of the above
+/// (The block mesh, fluid::block_solver, has its writers in block_vtk.hpp.)
 ///
 /// Encodings: `ascii` (17 significant digits, exact round-trip) or `binary` (the
 /// default): base64 inline data, VTK's `header_type="UInt64"` (each array is the
@@ -222,6 +223,7 @@ void for_each_part(const Assembly& a, F&& f) {
 /// Structure as a VTK UnstructuredGrid (see the file comment for the arrays). `time`
 /// (the TIME field) defaults to the assembly's time.
 template <class Assembly>
+requires requires(const Assembly& a) { a.node_set(); }
 void write_vtu(const std::filesystem::path& path, const Assembly& a, const vtu_options& opt = {},
                double time = std::numeric_limits<double>::quiet_NaN()) {
   if (std::isnan(time)) time = a.time();

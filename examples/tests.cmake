@@ -179,11 +179,11 @@ parafsi_example_fails(example_drop_guide_bad_t_end drop_guide --t-end -1 --out $
 parafsi_example_dir_test(example_parachute_drop_tiny_pgs parachute_drop "history.csv|summary.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --pgs 4 --slice-times 0.01 --quiet)
-# The block mesh (penalty coupling): the tiny scene for 20 ms, history, summary and a slice.
+# The block mesh (penalty coupling): the tiny scene for 20 ms, history, summary, a slice, VTK.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "history.csv|summary.csv|slice_00.010.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"
   "5|1|1280" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --coupling penalty --block-size 4
-  --slice-times 0.01 --quiet)
+  --slice-times 0.01 --vtk-every 0.01 --quiet)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)
@@ -257,8 +257,6 @@ parafsi_example_refuses(example_parachute_drop_blocks_embedded parachute_drop ""
   --mesh blocks --coupling embedded)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
-parafsi_example_refuses(example_parachute_drop_blocks_vtk parachute_drop "" "--vtk-every with --mesh blocks"
-  --mesh blocks --coupling penalty --vtk-every 0.1)
 # Counts from doubles: refused before anything is cast or allocated, naming the count.
 parafsi_example_refuses(example_parachute_drop_tiny_cell parachute_drop "" "would have more than 1e308 cells"
   --cell 1e-300)

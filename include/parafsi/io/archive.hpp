@@ -157,7 +157,7 @@ template <class T>
 std::string show(const T& v) {
   if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
   else if constexpr (integer_like<T>) return std::to_string(to_i64(v));
-  else return detail::concat(v);
+  else return parafsi::detail::concat(v);
 }
 template <class T>
 bool same_value(const T& a, const T& b) {
@@ -373,7 +373,7 @@ class input_archive {
 
   template <class... A>
   [[noreturn]] void fail(A&&... a) const {
-    throw checkpoint_error(detail::concat(where_, ": ", std::forward<A>(a)...));
+    throw checkpoint_error(parafsi::detail::concat(where_, ": ", std::forward<A>(a)...));
   }
 
  private:
@@ -397,7 +397,7 @@ class input_archive {
   void finite(std::string_view name, const double* p, std::size_t n) const {
     for (std::size_t i = 0; i < n; ++i)
       if (!std::isfinite(p[i]))
-        fail("entry '", full(name), "' holds a non-finite value (", p[i], n > 1 ? detail::concat(" at index ", i) : "",
+        fail("entry '", full(name), "' holds a non-finite value (", p[i], n > 1 ? parafsi::detail::concat(" at index ", i) : "",
              ")");
   }
   std::size_t count(std::size_t elem) {
@@ -477,7 +477,7 @@ class checkpoint_file {
  public:
   explicit checkpoint_file(const std::filesystem::path& path) : path_(path.string()) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw checkpoint_error(detail::concat("checkpoint ", path_, ": cannot open the file"));
+    if (!in) throw checkpoint_error(parafsi::detail::concat("checkpoint ", path_, ": cannot open the file"));
     std::vector<unsigned char> all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::size_t m = checkpoint_magic.size();
     if (all.size() < m || std::memcmp(all.data(), checkpoint_magic.data(), m) != 0)
@@ -523,7 +523,7 @@ class checkpoint_file {
 
   template <class... A>
   [[noreturn]] void fail(A&&... a) const {
-    throw checkpoint_error(detail::concat("checkpoint ", path_, ": ", std::forward<A>(a)...));
+    throw checkpoint_error(parafsi::detail::concat("checkpoint ", path_, ": ", std::forward<A>(a)...));
   }
 
  private:

@@ -71,6 +71,7 @@
 #include "../coupling/coupling.hpp"
 #include "../explicit_stepper.hpp"
 #include "../fluid/fluid.hpp"
+#include "../io/block_vtk.hpp"
 #include "../io/checkpoint.hpp"
 #include "../io/drop_history.hpp"
 #include "../io/drop_slice.hpp"
@@ -144,7 +145,6 @@ struct drop_config {
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
-      require(vtk_every == 0, "parachute_drop: --vtk-every with --mesh blocks is not available yet");
     }
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
@@ -538,11 +538,13 @@ class drop_run {
     if (pvd_ && s_.time() >= next_vtk_ - 1e-9 * c_.history_every) {
       char nm[64];
       std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
-      const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu", ff = c_.out + "/vtk/fluid_" + nm + ".vts";
+      const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu",
+                        ff = c_.out + "/vtk/fluid_" + nm + (block_mesh ? ".vtu" : ".vts");
       io::write_vtu(fs, s_.structure());
       io::vtk_options vo;
       vo.pressure_offset = p_offset_;
-      if constexpr (!block_mesh) io::write_vts(ff, s_.fluid(), vo);
+      if constexpr (block_mesh) io::write_vtu(ff, s_.fluid(), vo);  // leaf cells as hexahedra
+      else io::write_vts(ff, s_.fluid(), vo);
       pvd_->add(s_.time(), ff, 0);
       pvd_->add(s_.time(), fs, 1);
       next_vtk_ += c_.vtk_every;

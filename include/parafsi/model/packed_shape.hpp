@@ -37,14 +37,15 @@
 ///     longer than its reference in any direction, and each is at its reference length in
 ///     exactly one (near the meridian: the seam and centreline lines are at
 ///     √(ρ² + ζ²) ≈ cos(π/2N) of their reference length, 0.981 for N = 8, 0.998 for
-///     N = 28); across the gore (in hoop) the cloth is gathered, stress-free under
-///     no-compression, to ≈ ρ of its width. ζ is the largest meridional extent a map that is
+///     N = 28); across the gore (in hoop) the cloth is gathered to ≈ ρ of its width,
+///     stress-free under no-compression (up to the wrinkling model's residual r_c of the
+///     compressive stress, docs/model.md). ζ is the largest meridional extent a map that is
 ///     linear on each half-gore allows (a longer one stretches the half-gore along the
 ///     bisector of seam and centreline), so the vent → skirt-corner height ζ (R_s − R_v) is
-///     0.976–0.980 of the seam length for N = 8 and d = 0.1–0.05 D0. Element area ratio ≈ ρ (no degenerate element); the
-///     normals point outwards from the axis. The suspension lines (suspension_lines.hpp)
-///     then meet at the confluence √(Ls² − d²/4) below the skirt corners: every line
-///     straight and exactly Ls long, at stretch.
+///     0.976–0.980 of the seam length for N = 8 and d = 0.1–0.05 D0. Element area ratio
+///     ≈ ρ (no degenerate element); the normals point outwards from the axis. The
+///     suspension lines (suspension_lines.hpp) then meet at the confluence √(Ls² − d²/4)
+///     below the skirt corners: every line straight and exactly Ls long, at stretch.
 ///   The "pulled" shape (structure-only pre-simulation) needs the solver and is built by
 ///   the drop program from one of these.
 #pragma once

@@ -18,7 +18,9 @@
 // (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
 // following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
-// --payload-mass, --initial-speed (extreme scenes).
+// --payload-mass, --initial-speed (extreme scenes). A deployment's start: --packed bundle
+// (the canopy gathered at line stretch, --packed-parameter its mouth / D0) with
+// --initial-speed the speed at line stretch.
 //
 // Writes in DIR: history.csv (one row per --history-every ≤ 5 ms; its last column the
 // riser force low-pass filtered at --force-cutoff, 10 Hz), summary.csv, and
@@ -179,7 +181,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_flag("--quiet", c.quiet, "no progress on stderr");
-  app.add_option("--initial-speed", c.initial_speed, "override: release speed (m/s); default: the scene's")
+  app.add_option("--initial-speed", c.initial_speed,
+                 "override: release speed (m/s), every node and the payload along the flight path in still air "
+                 "(with --packed bundle: the speed at line stretch); default: the scene's")
       ->check(finite)
       ->check(CLI::Range(0.0, 200.0));
   app.add_option(
@@ -204,10 +208,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 1e3))
       ->capture_default_str();
   app.add_option("--packed", c.packed, "initial packed canopy shape (scene: the scene's, reduced radius 0.2 for paper)")
-      ->check(CLI::IsMember({"scene", "reduced_radius", "star_fold", "constructed"}))
+      ->check(CLI::IsMember({"scene", "reduced_radius", "star_fold", "bundle", "constructed"}))
       ->capture_default_str();
   app.add_option("--packed-parameter", c.packed_parameter,
-                 "reduced_radius: radial scale s (default 0.2); star_fold: seam half-angle in degrees (default 5)")
+                 "reduced_radius: radial scale s (default 0.2); star_fold: seam half-angle in degrees (default 5); "
+                 "bundle: mouth diameter / D0, in [0.01, 0.5] (default 0.1)")
       ->check(finite)
       ->check(CLI::Range(0.0, 89.0));
   app.add_option("--box", c.box, "fluid box: follow (the paper's, moves and turns with the payload) or fixed")

@@ -257,6 +257,13 @@ parafsi_example_refuses(example_parachute_drop_blocks_embedded parachute_drop ""
   --mesh blocks --coupling embedded)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
+# The bundle's mouth diameter outside [0.01, 0.5] D0 (a smaller one would leave elements of ≈ d/D0 of their area).
+parafsi_example_refuses(example_parachute_drop_bundle_mouth_small parachute_drop ""
+  "--packed-parameter 0: the bundle's mouth diameter d/D0 must be in \\[0\\.01, 0\\.5\\]"
+  --resolution tiny --t-end 0.01 --quiet --packed bundle --packed-parameter 0)
+parafsi_example_refuses(example_parachute_drop_bundle_mouth_large parachute_drop ""
+  "--packed-parameter 0\\.75: the bundle's mouth diameter d/D0 must be in \\[0\\.01, 0\\.5\\]"
+  --resolution tiny --t-end 0.01 --quiet --packed bundle --packed-parameter 0.75)
 # Counts from doubles: refused before anything is cast or allocated, naming the count.
 parafsi_example_refuses(example_parachute_drop_tiny_cell parachute_drop "" "would have more than 1e308 cells"
   --cell 1e-300)

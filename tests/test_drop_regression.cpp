@@ -221,7 +221,8 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
 }
 
 // Settings that would be dropped silently are refused before anything is built, naming
-// the flag: output intervals without an output directory, a reduced radius of 0, slice
+// the flag: output intervals without an output directory, a reduced radius of 0, a bundle
+// mouth outside [0.01, 0.5] D0, slice
 // times that are not output instants or not in order.
 TEST_CASE("drop config: silently dropped settings are refused by name") {
   using cfg = parafsi::scene::drop_config;
@@ -241,6 +242,11 @@ TEST_CASE("drop config: silently dropped settings are refused by name") {
   c.packed = "reduced_radius";
   c.packed_parameter = 0;
   refused(c, "--packed-parameter 0: the reduced radius s of the packed canopy must be in (0, 1]");
+  c.packed = "bundle";
+  c.packed_parameter = 0;
+  refused(c, "--packed-parameter 0: the bundle's mouth diameter d/D0 must be in [0.01, 0.5]");
+  c.packed_parameter = 0.75;
+  refused(c, "--packed-parameter 0.75: the bundle's mouth diameter d/D0 must be in [0.01, 0.5]");
   c = cfg{};
   c.slice_times = {0.0123};
   refused(c, "--slice-times 0.0123 s is not an output instant (a multiple of --history-every");

@@ -1,13 +1,18 @@
-// Drop-scene builders: packed shapes, lines, riser, payload, masses, the C-9 variant, rejection;
-// the duct/screen scene of the coupling tests.
+// Drop-scene builders: packed shapes (the bundle at line stretch too), lines, riser, payload,
+// masses, the C-9 variant, rejection; the duct/screen scene of the coupling tests.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <string>
+#include <utility>
 
+#include <Eigen/Dense>
+
+#include <parafsi/model/drop_box.hpp>
 #include <parafsi/model/drop_scene.hpp>
 #include <parafsi/model/duct_screen.hpp>
 
@@ -25,6 +30,22 @@ double max_edge_strain(const md::canopy_mesh& c, const std::vector<Eigen::Vector
       e = std::max(e, std::abs(L / L0 - 1.0));
     }
   return e;
+}
+/// Largest principal stretch of the affine map of triangle t from the cut pattern to x
+/// (the square root of the larger eigenvalue of C = F^T F in the element's plane), and the
+/// area ratio |x-triangle| / |pattern triangle|.
+std::pair<double, double> element_stretch(const md::canopy_mesh& c, const std::vector<Eigen::Vector3d>& x,
+                                          const std::array<index_t, 3>& t) {
+  const auto P = [&](int a) { return c.positions[std::size_t(t[std::size_t(a)])]; };
+  const auto Q = [&](int a) { return x[std::size_t(t[std::size_t(a)])]; };
+  const Eigen::Vector3d E1 = P(1) - P(0), E2 = P(2) - P(0), e1 = Q(1) - Q(0), e2 = Q(2) - Q(0);
+  Eigen::Matrix2d G, g;  // reference and current Gram matrices of the edge pair
+  G << E1.dot(E1), E1.dot(E2), E1.dot(E2), E2.dot(E2);
+  g << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+  const Eigen::Matrix2d Li = Eigen::Matrix2d(G.llt().matrixL()).inverse();
+  const Eigen::Matrix2d C = Li * g * Li.transpose();
+  const double m = 0.5 * C.trace(), lmax = m + std::sqrt(std::max(0.0, m * m - C.determinant()));
+  return {std::sqrt(lmax), e1.cross(e2).norm() / E1.cross(E2).norm()};
 }
 double max_radius(const std::vector<Eigen::Vector3d>& x, std::size_t n) {
   double r = 0;
@@ -65,9 +86,74 @@ TEST_CASE("packed shapes keep the reference and meet the requested radius scale"
                        pf::invalid_input);
 }
 
+// Bundle at line stretch: the half-gore map (packed_shape.hpp) keeps every element within
+// its reference (largest principal stretch exactly 1, in one direction), shrinks each
+// element's area by the same factor |S x M| / |e x m|, keeps the normals pointing outwards
+// from the axis, puts the skirt corners on the mouth circle and leaves every tape and band
+// no longer than its rest length.
+TEST_CASE("bundle: no element stretched, the mouth diameter, area ratio, outward normals") {
+  for (int gores : {8, 28}) {
+    md::canopy_parameters cp;
+    cp.gores = gores;
+    cp.element_size = gores == 8 ? 0.0333 : 0.05;  // the drop's coarse element; C-9 proportions
+    const auto c = md::flat_circular_canopy(cp);
+    const double pi = std::numbers::pi, a = std::cos(pi / gores);
+    for (double d : {0.01, 0.05, 0.1, 0.5}) {
+      const auto x = md::packed_positions(c, md::packed_shape::bundle(d));
+      const double rho = 0.5 * d / c.skirt_radius, zeta = std::cos(0.5 * pi / gores) * std::sqrt(1 - rho * rho);
+      const double area = std::sqrt((1 - a) * rho * rho * ((1 + a) * rho * rho + 2 * zeta * zeta)) /
+                          std::sin(pi / gores);
+      double smax = 0, amin = 1e300, amax = 0, outward = 1;
+      for (const auto& t : c.triangles) {
+        const auto [stretch, ratio] = element_stretch(c, x, t);
+        smax = std::max(smax, stretch);
+        amin = std::min(amin, ratio);
+        amax = std::max(amax, ratio);
+        const auto X = [&](int k) { return x[std::size_t(t[std::size_t(k)])]; };
+        const Eigen::Vector3d n = (X(1) - X(0)).cross(X(2) - X(0)).normalized(), m = (X(0) + X(1) + X(2)) / 3;
+        outward = std::min(outward, n.head<2>().dot(m.head<2>().normalized()));
+      }
+      std::printf(
+          "bundle N = %2d, d = %.2f D0: max principal stretch - 1 = %.1e, area ratio %.5f..%.5f (%.5f), "
+          "min outward normal %.3f, height %.4f m\n",
+          gores, d, smax - 1, amin, amax, area, outward, -x[std::size_t(c.line_attachment[0])].z());
+      CHECK(smax - 1 <= 1e-12);
+      CHECK(smax - 1 >= -1e-12);  // taut along one direction: at its reference length
+      CHECK(amin == doctest::Approx(area).epsilon(1e-9));
+      CHECK(amax == doctest::Approx(area).epsilon(1e-9));
+      CHECK(outward > 0.8);
+      // Mouth: every skirt corner (line attachment) on the circle of diameter d D0, at the
+      // same height zeta R_s below the vent centre; the vent centre stays at the apex.
+      for (const index_t i : c.line_attachment) {
+        CHECK(2 * x[std::size_t(i)].head<2>().norm() == doctest::Approx(d * cp.nominal_diameter).epsilon(1e-12));
+        CHECK(-x[std::size_t(i)].z() == doctest::Approx(zeta * c.skirt_radius).epsilon(1e-12));
+      }
+      CHECK(x[std::size_t(c.vent_centre)].norm() == 0.0);
+      // Seams and centrelines at sqrt(rho^2 + zeta^2) of their reference lengths.
+      for (const auto& seam : c.seams) {
+        const double L0 = (c.positions[std::size_t(seam.back())] - c.positions[std::size_t(seam.front())]).norm();
+        const double L = (x[std::size_t(seam.back())] - x[std::size_t(seam.front())]).norm();
+        CHECK(L / L0 == doctest::Approx(std::hypot(rho, zeta)).epsilon(1e-12));
+      }
+      // Tapes and bands: none longer than its rest length in the cut pattern.
+      for (const auto* segs : {&c.skirt_tape, &c.vent_tape, &c.band_segments})
+        for (const auto& e : *segs) {
+          const double L0 = (c.positions[std::size_t(e[1])] - c.positions[std::size_t(e[0])]).norm();
+          CHECK((x[std::size_t(e[1])] - x[std::size_t(e[0])]).norm() <= L0 * (1 + 1e-12));
+        }
+    }
+  }
+  const auto c = md::flat_circular_canopy({});
+  CHECK_THROWS_WITH_AS(md::packed_positions(c, md::packed_shape::bundle(0.005)),
+                       doctest::Contains("bundle mouth diameter d/D0 must be in [0.01, 0.5], got 0.005"),
+                       pf::invalid_input);
+  CHECK_THROWS_WITH_AS(md::packed_positions(c, md::packed_shape::bundle(0.75)), doctest::Contains("got 0.75"),
+                       pf::invalid_input);
+}
+
 TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geometry") {
   for (auto shape : {md::packed_shape::constructed(), md::packed_shape::reduced_radius(0.2),
-                     md::packed_shape::star_fold(5 * std::numbers::pi / 180)}) {
+                     md::packed_shape::star_fold(5 * std::numbers::pi / 180), md::packed_shape::bundle(0.1)}) {
     auto p = md::drop_scene_parameters::paper("mat59225");
     p.shape = shape;
     const auto s = md::build_drop_scene(p);
@@ -141,6 +227,29 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     for (const auto& cs : s.cables) CHECK(cs.rest_length.size() == cs.segments.size());
     // Packed radius scale in the scene.
     if (shape.kind == md::packed_kind::reduced_radius) CHECK(rho == doctest::Approx(0.2 * Rs).epsilon(1e-12));
+    if (shape.kind == md::packed_kind::bundle) {
+      // Line stretch: the skirt corners on the mouth circle (0.1 D0), every line segment at
+      // its rest length (relative 1e-12: a tension below EA 1e-12 = 1.4e-9 N), so the lines
+      // and the riser start straight and just taut; the canopy from its skirt corners to
+      // its vent centre inside the fluid box's refined block.
+      CHECK(2 * rho == doctest::Approx(0.1).epsilon(1e-12));
+      for (const auto k : {md::cable_kind::suspension_line, md::cable_kind::riser}) {
+        const auto& cs = s.cable(k);
+        for (std::size_t e = 0; e < cs.segments.size(); ++e) {
+          const double l =
+              (s.positions[std::size_t(cs.segments[e][1])] - s.positions[std::size_t(cs.segments[e][0])]).norm();
+          CHECK(l == doctest::Approx(cs.rest_length[e]).epsilon(1e-12));
+        }
+      }
+      const md::drop_box b = md::make_drop_box(s, md::drop_box_parameters{});
+      for (index_t i = 0; i < s.canopy_nodes; ++i) {
+        const Eigen::Vector3d xi = b.axes.transpose() * (s.positions[std::size_t(i)] - s.payload.position);
+        for (int d = 0; d < 3; ++d) {
+          CHECK(xi[d] >= b.fine_lo[std::size_t(d)]);
+          CHECK(xi[d] <= b.fine_hi[std::size_t(d)]);
+        }
+      }
+    }
     std::printf(
         "paper scene (%s): %ld nodes, %zu triangles, cloth %.4f kg, total %.4f kg, line EA %.0f N, "
         "confluence %.4f m below skirt\n",

@@ -3,9 +3,10 @@
 
 For each program, the numeric flags are read from its own --help (CLI11: `--name FLOAT`,
 `--name INT`, `--name TEXT:X,Y,Z`); each is given each of the values nan, inf, -1, 0,
-1e300 and 1e-300 on top of a short base run. A case passes when the program either runs
-to a clean exit (0) within the time limit or exits non-zero with a message that names the
-flag. A timeout, a crash (signal) or a refusal that does not name the flag fails.
+1e300 and 1e-300 on top of a short base run; a flag whose meaning depends on another
+flag (--packed-parameter) also on the variants of that run in VARIANTS. A case passes when
+the program either runs to a clean exit (0) within the time limit or exits non-zero with a
+message that names the flag. A timeout, a crash (signal) or a refusal that does not name the flag fails.
 
   cli_robustness.py --bin <build>/examples [--timeout 20] [--jobs 2] [--only prog,...]
 """
@@ -41,6 +42,14 @@ BASE = {
     "tumbling_box": ["--omega", "0.1,2,0.1", "--inertia", "1,2,3", "--t-end", "0.01", "--out", "{tmp}/tumble.csv"],
 }
 
+# Variants of a program's base run for the flags whose meaning depends on another flag:
+# (label, program, extra base flags, flags to vary). The label names the case in the report.
+VARIANTS = [
+    ("parachute_drop --packed bundle", "parachute_drop", ["--packed", "bundle"], ["--packed-parameter"]),
+    ("parachute_drop --packed reduced_radius", "parachute_drop", ["--packed", "reduced_radius"],
+     ["--packed-parameter"]),
+]
+
 OPTION = re.compile(r"^\s+(?:-\w,)?(--[\w-]+)\s+(FLOAT|INT|UINT|TEXT:X,Y,Z)\b")
 
 
@@ -65,11 +74,11 @@ def with_flag(base, flag, value):
     return args + [flag, value]
 
 
-def run_case(exe, prog, flag, kind, value, timeout):
+def run_case(exe, prog, flag, kind, value, timeout, base=None):
     tmp = tempfile.mkdtemp(prefix="parafsi_cli_")
     try:
         v = value if kind != "TEXT:X,Y,Z" else value + ",1,1"
-        args = [a.replace("{tmp}", tmp) for a in with_flag(BASE[prog], flag, v)]
+        args = [a.replace("{tmp}", tmp) for a in with_flag(base or BASE[prog], flag, v)]
         t0 = time.monotonic()
         try:
             p = subprocess.run([exe] + args, capture_output=True, text=True, timeout=timeout,
@@ -109,6 +118,15 @@ def main():
             print("cli_robustness: no numeric flags in %s --help" % prog)
             return 1
         cases += [(exe, prog, f, k, v, a.timeout) for f, k in flags for v in VALUES]
+        for label, vprog, extra, vflags in VARIANTS:
+            if vprog != prog:
+                continue
+            kinds = dict(flags)
+            for f in vflags:
+                if f not in kinds:
+                    print("cli_robustness: %s has no numeric flag %s" % (prog, f))
+                    return 1
+                cases += [(exe, label, f, kinds[f], v, a.timeout, BASE[prog] + extra) for v in VALUES]
     t0 = time.monotonic()
     with cf.ThreadPoolExecutor(a.jobs) as pool:
         results = list(pool.map(lambda c: run_case(*c), cases))

@@ -16,7 +16,10 @@
 /// from the payload to the canopy), rotated so the axis points against the flight
 /// direction v̂ = (cos γ, 0, −sin γ) (γ the flight-path angle, 90° = straight down,
 /// gravity −z), and translated so the payload mass centre is at (0, 0, release height).
-/// All nodes and the payload start with velocity V v̂ (V the initial speed).
+/// All nodes and the payload start with velocity V v̂ (V the initial speed), every line
+/// straight and exactly Ls long (suspension_lines.hpp), the canopy stress-free in its packed
+/// shape; the air (the drop program's) starts at rest. With `packed_shape::bundle` this is a
+/// bag deployment at line stretch and V is the speed at line stretch.
 ///
 /// Use with the structure module: `nodes.add(positions[i], velocities[i], point_mass[i])`;
 /// `triangle_mesh{triangles, reference, warp}` with
@@ -65,7 +68,7 @@ struct drop_scene_parameters {
   std::string name = "paper";
   // Table 3
   double release_height = 35.0;     ///< payload mass centre height (m)
-  double initial_speed = 0.0;       ///< m/s
+  double initial_speed = 0.0;       ///< m/s, of every node and the payload (with a bundle: at line stretch)
   double flight_path_angle = 90.0;  ///< degrees below the horizontal
   double air_density = 1.18;        ///< kg/m³
   double air_pressure = 101325.0;   ///< Pa

@@ -23,7 +23,8 @@
 /// r_i = R_v + (R_s − R_v) i/n_r; a half-gore's row i holds m_i = max(1, round(r_i sin(π/N)/h))
 /// segments (h the target element size), so elements keep their size from vent to skirt;
 /// adjacent rows are joined by the advancing-front merge of two monotone point rows.
-/// Seams and centrelines are mesh lines (needed by the isometric star fold, packed_shape.hpp).
+/// Seams and centrelines are mesh lines (needed by the star fold and the bundle, packed_shape.hpp,
+/// which map each half-gore linearly).
 ///
 /// Fibre directions. Warp along the gore centreline (radial at the gore's middle),
 /// rotated by `fibre_angle` about the normal (π/4: bias construction, Knacke §6). The

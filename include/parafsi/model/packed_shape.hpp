@@ -22,6 +22,30 @@
 ///     (e_k the seam direction, m_k = a n_k the centreline point at unit seam distance)
 ///     goes to α S_k + β M_k with S_k = sin θ_s e_k − cos θ_s e_z and
 ///     M_k = a (sin θ_m n_k − cos θ_m e_z).
+///   - `bundle{d}`: the canopy at line stretch as it leaves its deployment bag, gathered
+///     into a slender bundle along the axis: the vent centre at the top (the origin), the
+///     gores running down the axis, the skirt below with its N corners (the line
+///     attachments) on the mouth circle of diameter d (d/D0 in [0.01, 0.5], 0.05–0.1 typical;
+///     the elements' areas shrink to ≈ d/D0 of their reference, so a smaller mouth is refused).
+///     Each half-gore is mapped linearly like the star fold, p = α e_k + β m_k ↦ α S_k + β M_k,
+///     with the seams on a cone and the centrelines a times as far out and down:
+///         S_k = ρ e_k − ζ e_z,   M_k = a (ρ n_k − ζ e_z),   ρ = d / (2 R_s),
+///         ζ = cos(π/2N) √(1 − ρ²).
+///     With G = [[1, a²], [a², a²]] the reference Gram matrix of (e_k, m_k) and G' that of
+///     (S_k, M_k), G − G' = [[A, B], [B, a² A]] with A = (1 − ρ²)(1 − a)/2 > 0 and
+///     B = −a A, so G − G' is positive semi-definite with one null direction: no element is
+///     longer than its reference in any direction, and each is at its reference length in
+///     exactly one (near the meridian: the seam and centreline lines are at
+///     √(ρ² + ζ²) ≈ cos(π/2N) of their reference length, 0.981 for N = 8, 0.998 for
+///     N = 28); across the gore (in hoop) the cloth is gathered to ≈ ρ of its width,
+///     stress-free under no-compression (up to the wrinkling model's residual r_c of the
+///     compressive stress, docs/model.md). ζ is the largest meridional extent a map that is
+///     linear on each half-gore allows (a longer one stretches the half-gore along the
+///     bisector of seam and centreline), so the vent → skirt-corner height ζ (R_s − R_v) is
+///     0.976–0.980 of the seam length for N = 8 and d = 0.1–0.05 D0. Element area ratio
+///     ≈ ρ (no degenerate element); the normals point outwards from the axis. The
+///     suspension lines (suspension_lines.hpp) then meet at the confluence √(Ls² − d²/4)
+///     below the skirt corners: every line straight and exactly Ls long, at stretch.
 ///   The "pulled" shape (structure-only pre-simulation) needs the solver and is built by
 ///   the drop program from one of these.
 #pragma once
@@ -37,16 +61,21 @@
 
 namespace parafsi::model {
 
-enum class packed_kind { constructed, reduced_radius, star_fold };
+enum class packed_kind { constructed, reduced_radius, star_fold, bundle };
 
 struct packed_shape {
   packed_kind kind = packed_kind::reduced_radius;
   double scale = 0.2;                                       ///< s of reduced_radius
   double seam_half_angle = 5.0 * std::numbers::pi / 180.0;  ///< θ_s of star_fold (rad)
+  double mouth_diameter = 0.1;                              ///< d / D0 of bundle
 
   static packed_shape constructed() { return {packed_kind::constructed, 1.0, 0.0}; }
   static packed_shape reduced_radius(double s) { return {packed_kind::reduced_radius, s, 0.0}; }
   static packed_shape star_fold(double theta_s) { return {packed_kind::star_fold, 1.0, theta_s}; }
+  /// The bundle at line stretch with a mouth of `mouth_diameter_fraction` · D0 across the skirt corners.
+  static packed_shape bundle(double mouth_diameter_fraction) {
+    return {packed_kind::bundle, 1.0, 0.0, mouth_diameter_fraction};
+  }
 
   void validate() const {
     if (kind == packed_kind::reduced_radius)
@@ -55,12 +84,16 @@ struct packed_shape {
     if (kind == packed_kind::star_fold)
       require(seam_half_angle >= 0 && seam_half_angle < 0.5 * std::numbers::pi,
               "model::packed_shape: star-fold seam half-angle must be in [0, pi/2) rad, got ", seam_half_angle);
+    if (kind == packed_kind::bundle)
+      require(mouth_diameter >= 0.01 && mouth_diameter <= 0.5,
+              "model::packed_shape: bundle mouth diameter d/D0 must be in [0.01, 0.5], got ", mouth_diameter);
   }
   const char* name() const {
     switch (kind) {
       case packed_kind::constructed: return "constructed";
       case packed_kind::reduced_radius: return "reduced_radius";
-      default: return "star_fold";
+      case packed_kind::star_fold: return "star_fold";
+      default: return "bundle";
     }
   }
 };
@@ -82,12 +115,21 @@ inline std::vector<Eigen::Vector3d> packed_positions(const canopy_mesh& c, const
     return x;
   }
   const int N = c.params.gores;
-  const double pi = std::numbers::pi, a = std::cos(pi / N), ts = s.seam_half_angle;
-  const double tm = star_fold_centreline_angle(N, ts);
+  const double pi = std::numbers::pi, a = std::cos(pi / N);
   const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+  // Images S of the unit seam vector e_s and M of the unit centreline point a n_m of a half-gore.
+  double Sh, Sz, Mh, Mz;  // S = Sh e_s − Sz e_z, M = a (Mh n_m − Mz e_z)
+  if (s.kind == packed_kind::star_fold) {
+    const double ts = s.seam_half_angle, tm = star_fold_centreline_angle(N, ts);
+    Sh = std::sin(ts), Sz = std::cos(ts), Mh = std::sin(tm), Mz = std::cos(tm);
+  } else {  // bundle; ρ <= 0.5 since R_s >= D0/2
+    const double rho = 0.5 * s.mouth_diameter * c.params.nominal_diameter / c.skirt_radius;
+    Sh = Mh = rho;
+    Sz = Mz = std::cos(0.5 * pi / N) * std::sqrt(1.0 - rho * rho);
+  }
   for (auto& p : x) {
     const double r = p.head<2>().norm();
-    if (r == 0.0) continue;  // the vent centre is the fold's apex
+    if (r == 0.0) continue;  // the vent centre is the apex
     double phi = std::atan2(p.y(), p.x());
     if (phi < 0) phi += 2.0 * pi;
     const double w = 2.0 * pi / N;
@@ -100,8 +142,8 @@ inline std::vector<Eigen::Vector3d> packed_positions(const canopy_mesh& c, const
     Eigen::Matrix2d M;
     M << es.x(), mk.x(), es.y(), mk.y();
     const Eigen::Vector2d ab = M.colPivHouseholderQr().solve(p.head<2>());
-    const Eigen::Vector3d S = std::sin(ts) * es - std::cos(ts) * ez;
-    const Eigen::Vector3d Mk = a * (std::sin(tm) * nm - std::cos(tm) * ez);
+    const Eigen::Vector3d S = Sh * es - Sz * ez;
+    const Eigen::Vector3d Mk = a * (Mh * nm - Mz * ez);
     p = ab.x() * S + ab.y() * Mk;
   }
   return x;

@@ -110,8 +110,8 @@ struct drop_config {
   double payload_mass = -1;      ///< override of the payload mass (kg), <= 0 = scene
   double line_stiffness = 1;     ///< multiplies EA of lines, riser and tapes (sensitivity, extremes)
   double modulus_scale = 1;      ///< multiplies the fabric moduli E11, E22, G12
-  std::string packed = "scene";  ///< scene | reduced_radius | star_fold | constructed
-  double packed_parameter = -1;  ///< reduced_radius: s; star_fold: seam half-angle (deg); < 0 = default
+  std::string packed = "scene";  ///< scene | reduced_radius | star_fold | bundle | constructed
+  double packed_parameter = -1;  ///< reduced_radius: s; star_fold: θ_s (deg); bundle: mouth d/D0; < 0 = default
   std::string box = "follow";    ///< follow: the paper's moving box; fixed: a fixed box holding the fall
   double fixed_fall = 0;         ///< fixed box: fall length (m) the refined column extends below the start
   std::vector<double> slice_times{0.1, 0.2, 0.3, 0.5, 1, 2, 4, 6};  ///< mid-plane slice times (s)
@@ -133,7 +133,7 @@ struct drop_config {
             coupling, "'");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
-    require(one_of(packed, {"scene", "reduced_radius", "star_fold", "constructed"}),
+    require(one_of(packed, {"scene", "reduced_radius", "star_fold", "bundle", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
@@ -209,6 +209,9 @@ struct drop_config {
     require(packed != "reduced_radius" || packed_parameter < 0 || (packed_parameter > 0 && packed_parameter <= 1),
             "parachute_drop: --packed-parameter ", packed_parameter,
             ": the reduced radius s of the packed canopy must be in (0, 1] (negative: the default 0.2)");
+    require(packed != "bundle" || packed_parameter < 0 || (packed_parameter >= 0.01 && packed_parameter <= 0.5),
+            "parachute_drop: --packed-parameter ", packed_parameter,
+            ": the bundle's mouth diameter d/D0 must be in [0.01, 0.5] (negative: the default 0.1)");
     require(std::is_sorted(slice_times.begin(), slice_times.end()),
             "parachute_drop: --slice-times must be in increasing order");
     for (double t : slice_times)  // a slice is written at an output instant and labelled with its time
@@ -265,6 +268,8 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   else if (c.packed == "star_fold")
     P.shape = model::packed_shape::star_fold((c.packed_parameter >= 0 ? c.packed_parameter : 5.0) * std::numbers::pi /
                                              180.0);
+  else if (c.packed == "bundle")
+    P.shape = model::packed_shape::bundle(c.packed_parameter > 0 ? c.packed_parameter : 0.1);
   else if (c.packed == "constructed") P.shape = model::packed_shape::constructed();
   su.fixed_box = c.box == "fixed";
   P.canopy.element_size = R.element * D0;

@@ -397,8 +397,8 @@ class input_archive {
   void finite(std::string_view name, const double* p, std::size_t n) const {
     for (std::size_t i = 0; i < n; ++i)
       if (!std::isfinite(p[i]))
-        fail("entry '", full(name), "' holds a non-finite value (", p[i], n > 1 ? parafsi::detail::concat(" at index ", i) : "",
-             ")");
+        fail("entry '", full(name), "' holds a non-finite value (", p[i],
+             n > 1 ? parafsi::detail::concat(" at index ", i) : "", ")");
   }
   std::size_t count(std::size_t elem) {
     std::uint64_t n;

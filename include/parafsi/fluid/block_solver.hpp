@@ -224,6 +224,7 @@ class block_solver {
   index_t cell_count() const noexcept { return block_count() * n_ * n_ * n_; }
   void set_threading(bool on) noexcept { threaded_ = on; }
   const phase_times& timings() const noexcept { return times_; }
+  void reset_timings() noexcept { times_ = {}; }
 
   std::string name() const {
     return std::string("fluid::block_solver<") + Flux::name() + ", recon:" + Recon::name() + ", " + Frame::name() +

@@ -109,6 +109,7 @@ class block_solver {
     std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
     std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
     std::vector<char> bad_rows;
+    mutable std::vector<double> rate_slots;  ///< stable_dt's per-row maxima
   };
 
   template <policy... Ps>
@@ -281,14 +282,7 @@ class block_solver {
   fluid::totals totals() const {
     fluid::totals t;
     for_each_cell([&](const block& b, index_t i, index_t j, index_t k) {
-      const double vol = b.grid.cell_volume(i, j, k);
-      const auto q = detail::load_cons(detail::conserved_ptrs(b.U), b.grid.index(i, j, k));
-      t.mass += q.rho * vol;
-      t.momentum[0] += q.m.x * vol;
-      t.momentum[1] += q.m.y * vol;
-      t.momentum[2] += q.m.z * vol;
-      t.energy += q.E * vol;
-      t.kinetic += 0.5 * dot(q.m, q.m) / q.rho * vol;
+      t.add(detail::load_cons(detail::conserved_ptrs(b.U), b.grid.index(i, j, k)), b.grid.cell_volume(i, j, k));
     });
     return t;
   }
@@ -297,16 +291,15 @@ class block_solver {
   /// Largest stable step over all blocks: CFL / max Σ_d (|u_d − w_d| + c)/h_d.
   double stable_dt(double cfl = 0.5) const {
     require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt: CFL must be in (0, 1], got ", cfl);
-    std::vector<double> rate(blocks_.size(), 0.0);
+    rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
     detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
-      std::vector<double> slots;
-      rate[std::size_t(id)] = detail::max_wave_rate<false>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
-                                                           viscosity::inviscid{}, turbulence::none{}, nullptr, cfl,
-                                                           slots, false);
+      rate_[std::size_t(id)] = detail::max_wave_rate<false>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
+                                                            viscosity::inviscid{}, turbulence::none{}, nullptr, cfl,
+                                                            b.rate_slots, false);
     });
     double lam = 0.0;
-    for (double r : rate) lam = std::max(lam, r);
+    for (double r : rate_) lam = std::max(lam, r);
     require(std::isfinite(lam) && lam > 0.0, "fluid::block_solver::stable_dt: non-finite wave speed");
     return cfl / lam;
   }
@@ -514,15 +507,7 @@ class block_solver {
     using detail::timed;
     const auto geo = detail::geometry(pose_);
     const index_t nb = block_count();
-    timed(times_.boundaries, [&] {
-      detail::par_for(threaded_, 0, nb,
-                      [&](index_t id) { blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_); });
-      detail::par_for(threaded_, 0, nb, [&](index_t id) {
-        block& b = blocks_[std::size_t(id)];
-        if (b.boundary != std::array<bool, 6>{})
-          detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary);
-      });
-    });
+    timed(times_.boundaries, [&] { fill_ghosts_all(t); });
     // One buffer set per thread of the block loop, handed to the serial kernels inside.
     bufs_.resize(std::size_t(parallel::max_threads()));
     for (auto& set : bufs_) detail::ensure_row_buffers(set, n_);
@@ -736,6 +721,7 @@ class block_solver {
   blocks::block_fields U_all_;
   std::vector<std::vector<detail::row_buffers>> bufs_;  ///< per thread of the block loop
   bool sources_on_ = false;
+  mutable std::vector<double> rate_;  ///< stable_dt's per-block maxima
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   phase_times times_{};
   bool threaded_ = false;

@@ -83,6 +83,16 @@ struct totals {
   std::array<double, 3> momentum{};
   double energy = 0;
   double kinetic = 0;  ///< kinetic energy ½ ρ|u|² integrated (J)
+
+  /// Add a cell of conserved state q and volume vol.
+  void add(const cons<double>& q, double vol) noexcept {
+    mass += q.rho * vol;
+    momentum[0] += q.m.x * vol;
+    momentum[1] += q.m.y * vol;
+    momentum[2] += q.m.z * vol;
+    energy += q.E * vol;
+    kinetic += 0.5 * dot(q.m, q.m) / q.rho * vol;
+  }
 };
 
 template <class Flux = flux::hllc_lm, class Recon = recon::muscl<limiter::van_leer>,
@@ -274,16 +284,7 @@ class solver {
     fluid::totals t;
     for (index_t k = 0; k < grid_.n(2); ++k)
       for (index_t j = 0; j < grid_.n(1); ++j)
-        for (index_t i = 0; i < grid_.n(0); ++i) {
-          const double vol = grid_.cell_volume(i, j, k);
-          const auto q = conserved(i, j, k);
-          t.mass += q.rho * vol;
-          t.momentum[0] += q.m.x * vol;
-          t.momentum[1] += q.m.y * vol;
-          t.momentum[2] += q.m.z * vol;
-          t.energy += q.E * vol;
-          t.kinetic += 0.5 * dot(q.m, q.m) / q.rho * vol;
-        }
+        for (index_t i = 0; i < grid_.n(0); ++i) t.add(conserved(i, j, k), grid_.cell_volume(i, j, k));
     return t;
   }
 

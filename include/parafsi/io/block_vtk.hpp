@@ -224,15 +224,7 @@ void write_vtu(const std::filesystem::path& path, const fluid::block_solver<F, R
   x.array("level", 1, level, 8);
   x.array("block", 1, block, 8);
   out += "      <CellData Scalars=\"pressure\" Vectors=\"velocity\">\n" + x.s + "      </CellData>\n";
-  x.s.clear();
-  x.array("Points", 3, pts, 8);
-  out += "      <Points>\n" + x.s + "      </Points>\n";
-  x.s.clear();
-  x.array("connectivity", 1, conn, 8);
-  x.array("offsets", 1, offs, 8);
-  x.array("types", 1, types, 8);
-  out += "      <Cells>\n" + x.s + "      </Cells>\n";
-  out += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  out += detail::vtu_points_cells_end(x, pts, conn, offs, types);
   io::write_file_atomic(path, out);
 }
 

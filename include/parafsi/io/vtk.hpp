@@ -196,6 +196,22 @@ inline std::string vtk_header(const char* type) {
   return s;
 }
 
+/// The closing part of an UnstructuredGrid piece: its points, its cells and the end tags.
+template <class P, class C, class O, class T>
+std::string vtu_points_cells_end(xml_out& x, const std::vector<P>& pts, const std::vector<C>& conn,
+                                 const std::vector<O>& offs, const std::vector<T>& types) {
+  x.s.clear();
+  x.array("Points", 3, pts, 8);
+  std::string s = "      <Points>\n" + x.s + "      </Points>\n";
+  x.s.clear();
+  x.array("connectivity", 1, conn, 8);
+  x.array("offsets", 1, offs, 8);
+  x.array("types", 1, types, 8);
+  s += "      <Cells>\n" + x.s + "      </Cells>\n";
+  s += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  return s;
+}
+
 inline std::string time_field_data(double t, xml_out& x) {
   x.s.clear();
   x.array("TIME", 1, std::vector<double>{t}, 4);
@@ -309,15 +325,7 @@ void write_vtu(const std::filesystem::path& path, const Assembly& a, const vtu_o
   x.array("strain", 3, strain, 8);
   x.array("tension", 1, tension, 8);
   s += "      <CellData Scalars=\"effective_stress\">\n" + x.s + "      </CellData>\n";
-  x.s.clear();
-  x.array("Points", 3, pts, 8);
-  s += "      <Points>\n" + x.s + "      </Points>\n";
-  x.s.clear();
-  x.array("connectivity", 1, conn, 8);
-  x.array("offsets", 1, offs, 8);
-  x.array("types", 1, types, 8);
-  s += "      <Cells>\n" + x.s + "      </Cells>\n";
-  s += "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  s += detail::vtu_points_cells_end(x, pts, conn, offs, types);
   io::write_file_atomic(path, s);
 }
 

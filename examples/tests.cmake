@@ -184,6 +184,10 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "hist
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"
   "5|1|1280" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --coupling penalty --block-size 4
   --slice-times 0.01 --vtk-every 0.01 --quiet)
+# The block mesh with the embedded coupling (the default coupling): the tiny scene for 20 ms.
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_drop "history.csv|summary.csv"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --quiet)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)
@@ -253,8 +257,8 @@ endforeach()
 parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
   --t-end inf)
 # The block mesh's limits so far, named.
-parafsi_example_refuses(example_parachute_drop_blocks_embedded parachute_drop "" "runs the penalty coupling only"
-  --mesh blocks --coupling embedded)
+parafsi_example_refuses(example_parachute_drop_blocks_viscous parachute_drop "" "--mesh blocks is inviscid so far"
+  --mesh blocks --viscosity constant)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
 # The bundle's mouth diameter outside [0.01, 0.5] D0 (a smaller one would leave elements of ≈ d/D0 of their area).

@@ -78,6 +78,7 @@
 #include "../fluid/view.hpp"
 #include "../structure/assembly.hpp"
 #include "../structure/nodes.hpp"
+#include "detail/fluid_mesh.hpp"
 #include "detail/membrane_coupling.hpp"
 #include "kinds.hpp"
 #include "porosity/impermeable.hpp"
@@ -199,7 +200,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   template <class Fluid, class Asm>
   void exchange(Fluid& f, const Asm& s, double dt_f) {
     this->require_attached();
-    const auto& g = f.grid();
+    space_ = face_space::of(f);
     const auto& nd = s.node_set();
     const frame::pose& pose = f.pose();
     dt_f_ = dt_f;
@@ -213,7 +214,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
         const Eigen::Vector3d x = nd.position(t[std::size_t(a)]);
         const Eigen::Vector3d xi = pose.to_box(x);
         const Eigen::Vector3d vr = nd.velocity(t[std::size_t(a)]) - pose.grid_velocity(xi);
-        const double h = local_h(g, xi);
+        const double h = detail::local_width(f, xi);
         const double travel = vr.norm() * dt_f / h;
         if (travel > opt_.max_cells_per_step)
           throw numerical_failure(
@@ -226,7 +227,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
               e, f.time());
       }
     }
-    find_faces(g, nd, pose);
+    find_faces(nd, pose);
     face_J_.assign(faces_.size(), Eigen::Vector3d::Zero());
     std::fill(diag_.through_flow.begin(), diag_.through_flow.end(), 0.0);
     diag_.impulse_structure.setZero();
@@ -266,7 +267,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
       for (index_t i : tris_[std::size_t(e)]) {
         const Eigen::Vector3d xi = f.pose().to_box(nd.position(i));
         const double v = (nd.velocity(i) - f.pose().grid_velocity(xi)).norm();
-        if (v > 0) dt = std::min(dt, 0.5 * opt_.max_cells_per_step * local_h(f.grid(), xi) / v);
+        if (v > 0) dt = std::min(dt, 0.5 * opt_.max_cells_per_step * detail::local_width(f, xi) / v);
       }
     }
     return dt;
@@ -438,10 +439,12 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     double sign = 1;               ///< sign of n_element · n_face
   };
   struct face_rec {
-    index_t high;
+    index_t high;  ///< the fluid's cell above the face (flat index of its arrays)
     int axis;
     index_t first;  ///< first crossing in crossings_
     int n;          ///< layers
+    index_t low;    ///< the fluid's cell below the face
+    double area;    ///< face area (m²)
   };
   struct raw_crossing {
     index_t high;
@@ -449,26 +452,9 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     crossing c;
   };
 
-  static double local_h(const fluid::rectilinear_grid& g, const Eigen::Vector3d& xi) {
-    double h = std::numeric_limits<double>::infinity();
-    for (int d = 0; d < 3; ++d) {
-      if (g.n(d) <= 1) continue;
-      index_t lo = 0, hi = g.n(d) - 1;  // last cell whose low face is <= xi_d
-      while (lo < hi) {
-        const index_t mid = (lo + hi + 1) / 2;
-        if (g.face(d, mid) <= xi[d]) lo = mid;
-        else hi = mid - 1;
-      }
-      const index_t i = lo;
-      h = std::min(h, g.width(d, i));
-    }
-    return std::isfinite(h) ? h : g.min_width();
-  }
-
   /// Impedance matrices C_i = ζ Σ_faces (ρ_L c_L + ρ_R c_R) A (λ_a / k) n nᵀ of the nodes
   /// of crossed elements (cell states of tⁿ), their velocities vⁿ and the substep limit.
   void impedance_setup(const fluid::view& fv, const structure::nodes& nd) {
-    const fluid::rectilinear_grid& g = *fv.grid;
     const frame::pose& pose = *fv.pose;
     node_C_.assign(std::size_t(nd.size()), Eigen::Matrix3d::Zero());
     node_v0_.resize(std::size_t(nd.size()));
@@ -479,10 +465,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     };
     for (const auto& fr : faces_) {
       const int d = fr.axis;
-      const auto ijk = g.ijk(fr.high);
-      const int a1 = (d + 1) % 3, a2 = (d + 2) % 3;
-      const double area = g.width(a1, ijk[a1]) * g.width(a2, ijk[a2]);
-      const double Z = opt_.impedance * (impedance(fr.high - g.stride(d)) + impedance(fr.high));
+      const double area = fr.area;
+      const double Z = opt_.impedance * (impedance(fr.low) + impedance(fr.high));
       const Eigen::Vector3d n = pose.R.col(d);
       const Eigen::Matrix3d nn = n * n.transpose();
       for (int q = 0; q < fr.n; ++q) {
@@ -500,7 +484,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     diag_.impedance_substep = dt;
   }
 
-  void find_faces(const fluid::rectilinear_grid& g, const structure::nodes& nd, const frame::pose& pose) {
+  void find_faces(const structure::nodes& nd, const frame::pose& pose) {
+    const fluid::rectilinear_grid& g = space_.grid();
     std::vector<raw_crossing>& found = found_;
     found.clear();
     area_ = 0;
@@ -573,11 +558,11 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     faces_.clear();
     crossings_.clear();
     diag_.multi_layer_faces = 0;
+    const double ztol = 1e-9 * g.min_width();
     for (std::size_t i = 0; i < found.size();) {
       std::size_t j = i;
-      face_rec fr{found[i].high, found[i].axis, index_t(crossings_.size()), 0};
+      face_rec fr{found[i].high, found[i].axis, index_t(crossings_.size()), 0, 0, 0.0};
       double zlast = -std::numeric_limits<double>::infinity();
-      const double ztol = 1e-9 * g.min_width();
       while (j < found.size() && found[j].high == fr.high && found[j].axis == fr.axis) {
         if (found[j].c.z - zlast > ztol) {  // a new layer (same z: shared edge or vertex)
           crossings_.push_back(found[j].c);
@@ -587,6 +572,22 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
         ++j;
       }
       if (fr.n > 1) ++diag_.multi_layer_faces;
+      const int d = fr.axis, a1 = (d + 1) % 3, a2 = (d + 2) % 3;
+      const auto ijk = g.ijk(fr.high);
+      fr.area = g.width(a1, ijk[std::size_t(a1)]) * g.width(a2, ijk[std::size_t(a2)]);
+      fr.low = space_.cell(fr.high - g.stride(d));
+      fr.high = space_.cell(fr.high);
+      if (fr.low < 0 || fr.high < 0) {
+        const auto& cr = crossings_[std::size_t(fr.first)];
+        Eigen::Vector3d x(g.centre(0, ijk[0]), g.centre(1, ijk[1]), g.centre(2, ijk[2]));
+        x[d] = cr.z;
+        throw numerical_failure(
+            parafsi::detail::concat("coupling::embedded: membrane element ", cr.elem,
+                                    " crosses the face at box point (", x[0], ", ", x[1], ", ", x[2],
+                                    ") off the finest level of the block mesh: the membrane must lie in finest-level "
+                                    "cells (refine around it more often or with a wider buffer)"),
+            cr.elem, t_n_);
+      }
       faces_.push_back(fr);
       i = j;
     }
@@ -672,6 +673,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   std::vector<double> beta_;
   std::vector<raw_crossing> found_;            ///< find_faces scratch
   std::vector<fluid::patch_face> patch_list_;  ///< the faces patched in the coming fluid step
+  face_space space_{};                         ///< where the faces are found (the last exchange's mesh)
   bool spread_ready_ = false;
   embedded_diagnostics diag_{};
 };

@@ -27,7 +27,9 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -42,6 +44,7 @@
 #include "blocks/tree.hpp"
 #include "boundary/condition.hpp"
 #include "detail/ghosts.hpp"
+#include "detail/patch_faces.hpp"
 #include "detail/primitives.hpp"
 #include "detail/sources.hpp"
 #include "detail/stable_dt.hpp"
@@ -54,6 +57,7 @@
 #include "frame/fixed.hpp"
 #include "gas.hpp"
 #include "grid.hpp"
+#include "patch.hpp"
 #include "reconstruction/muscl.hpp"
 #include "solver.hpp"
 #include "time/ssp_rk2.hpp"
@@ -310,8 +314,11 @@ class block_solver {
     return p.current_motion();
   }
 
-  /// One Runge–Kutta step with the box motion m (see solver::step).
-  void step(double dt, const frame::motion& m) {
+  /// One Runge–Kutta step with the box motion m and the face patches of `patcher` (see
+  /// solver::step and patch.hpp): a patched face is named by its high cell's global index
+  /// and axis; its low cell is the same-level neighbour (in the block or the next one).
+  template <face_patcher Patcher>
+  void step(double dt, const frame::motion& m, Patcher& patcher) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
     pose_.set_motion(m);
     copy_state(*U0_, *U_);
@@ -322,14 +329,41 @@ class block_solver {
         pose_.advance((c - pose_time) * dt);
         pose_time = c;
       }
-      compute_rhs(t_ + c * dt);
+      compute_rhs(t_ + c * dt, s, patcher);
       update(Time::a[std::size_t(s)], Time::b[std::size_t(s)], dt, t_ + dt, s + 1 == Time::stages);
     }
     if (pose_time != 1.0) pose_.advance((1.0 - pose_time) * dt);
     t_ += dt;
     ++steps_;
   }
+  template <face_patcher Patcher>
+  void step(double dt, Patcher& patcher) {
+    step(dt, plan_motion(dt), patcher);
+  }
+  void step(double dt, const frame::motion& m) {
+    no_patches none;
+    step(dt, m, none);
+  }
   void step(double dt) { step(dt, plan_motion(dt)); }
+
+  /// Global index of the leaf cell beside cell `global` along `axis` (side 0: low, 1: high)
+  /// if it is a cell of the same level (the same block or a same-level neighbour block,
+  /// across a periodic axis too); −1 if that side is another level or outside the box.
+  index_t neighbour(index_t global, int axis, int side) const {
+    const index_t id = global / stride_, lc = global % stride_;
+    const block& b = blocks_[std::size_t(id)];
+    std::array<index_t, 3> ijk = b.grid.ijk(lc);
+    const index_t step = side ? 1 : -1;
+    ijk[std::size_t(axis)] += step;
+    if (ijk[std::size_t(axis)] >= 0 && ijk[std::size_t(axis)] < n_) return global + step * b.grid.stride(axis);
+    blocks::location q = b.where;
+    q.l[std::size_t(axis)] += step;
+    if (!tree_.wrap(q)) return -1;
+    const index_t nid = tree_.id_of(q);
+    if (nid < 0) return -1;
+    ijk[std::size_t(axis)] = side ? 0 : n_ - 1;
+    return global_index(nid, b.grid.index(ijk[0], ijk[1], ijk[2]));
+  }
 
   // ------------------------------------------------------------------ checkpoint
   /// Checkpoint (io/archive.hpp): the signature (type, ghosts, layout, gas), then time,
@@ -502,8 +536,9 @@ class block_solver {
   }
 
   // ------------------------------------------------------------------ phases
-  /// dU of one stage at time t on every block.
-  void compute_rhs(double t) {
+  /// dU of one stage at time t on every block, then the coupling's face patches.
+  template <class Patcher>
+  void compute_rhs(double t, int stage, Patcher& patcher) {
     using detail::timed;
     const auto geo = detail::geometry(pose_);
     const index_t nb = block_count();
@@ -526,8 +561,75 @@ class block_solver {
       });
       detail::par_for(threaded_, 0, nb, [&](index_t id) { correct_fluxes(id); });
     });
+    if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
       timed(times_.sources, [&] { detail::par_for(threaded_, 0, nb, [&](index_t id) { add_sources(id); }); });
+  }
+
+  /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp, first-
+  /// order membrane states): each face's regular flux is recomputed on the high cell's
+  /// block, whose ghost layer holds the low cell (a same-level copy), and the two cells'
+  /// rates are corrected, dU_low += (F − F_lo)/Δx, dU_high −= (F − F_hi)/Δx. Both cells
+  /// must be leaf cells of one level inside the box.
+  template <class Patcher>
+  void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
+    static_assert(!detail::wants_one_sided<Patcher>(),
+                  "fluid::block_solver: one-sided reconstruction beside membrane faces is not on the block mesh yet");
+    const std::span<const patch_face> faces = patcher.patch_faces();
+    const fluid::view state = view();
+    const auto dU = detail::conserved_ptrs(*dU_);
+    for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+      const index_t c = faces[pi].high;
+      const int d = faces[pi].axis;
+      require(d >= 0 && d < 3 && c >= 0 && c < stride_ * block_count(), "fluid::block_solver: bad patched face ", pi,
+              " (cell ", c, ", axis ", d, ")");
+      const index_t id = c / stride_, lc = c % stride_;
+      const block& b = blocks_[std::size_t(id)];
+      const auto ijk = b.grid.ijk(lc);
+      const index_t ic = ijk[std::size_t(d)];
+      const index_t m = neighbour(c, d, 0);
+      require(ic >= 0 && ic < n_ && ijk[std::size_t((d + 1) % 3)] >= 0 && ijk[std::size_t((d + 1) % 3)] < n_ &&
+                  ijk[std::size_t((d + 2) % 3)] >= 0 && ijk[std::size_t((d + 2) % 3)] < n_ && m >= 0,
+              "fluid::block_solver: patched face ", pi, " (cell ", c, ", axis ", d,
+              ") is not between two leaf cells of one level inside the box: the membrane must lie on one level "
+              "(refine around it)");
+      const index_t s = b.grid.stride(d), lm = lc - s;  // the low cell in this block's ghost layer if ic = 0
+      const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
+                                                detail::primitive_ptrs(std::as_const(b.W))};
+      double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
+      auto with_axis = [&](auto&& fn) {
+        if (d == 0) fn(std::integral_constant<int, 0>{});
+        else if (d == 1) fn(std::integral_constant<int, 1>{});
+        else fn(std::integral_constant<int, 2>{});
+      };
+      with_axis([&](auto D) {
+        detail::sweep_cell_faces<decltype(D)::value>(fk, lm, ic - 1, lo_m, hi_m);
+        detail::sweep_cell_faces<decltype(D)::value>(fk, lc, ic, lo_c, hi_c);
+      });
+      face_context fc;
+      fc.low = m;
+      fc.high = c;
+      fc.axis = d;
+      fc.stage = stage;
+      fc.patch = pi;
+      fc.L = detail::prim_of(hi_m);
+      fc.R = detail::prim_of(lo_c);
+      fc.n = geo.n[std::size_t(d)];
+      fc.centre = detail::face_centre(b.grid, d, lc);
+      fc.wn = detail::face_speed(geo, d, fc.centre);
+      const int a1 = (d + 1) % 3, a2 = (d + 2) % 3;
+      fc.area = b.grid.width(a1, ijk[std::size_t(a1)]) * b.grid.width(a2, ijk[std::size_t(a2)]);
+      const cons<double> F = flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
+      cons<double> Flo = F, Fhi = F;
+      patcher.patch(fc, state, Flo, Fhi);
+      const double idm = b.grid.inv_widths(d)[ic - 1], idc = b.grid.inv_widths(d)[ic];
+      const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
+      const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
+      for (int q = 0; q < 5; ++q) {
+        dU[q][m] += dlo[q] * idm;
+        dU[q][c] -= dhi[q] * idc;
+      }
+    }
   }
 
   /// Every block's ghosts: from neighbours, then the box's boundary conditions.

@@ -91,7 +91,7 @@ struct drop_config {
   std::string fabric = "mat544";      ///< paper canopy: mat544 | mat59225 | mat509
   std::string resolution = "coarse";  ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
   std::string coupling = "embedded";  ///< embedded | penalty
-  std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh (penalty only)
+  std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh (inviscid)
   int block_size = 8;                 ///< blocks: cells per block edge
   int refine_every = 5;               ///< blocks: regrid to the canopy every this many steps
   std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
@@ -138,9 +138,6 @@ struct drop_config {
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
     if (mesh == "blocks") {
-      require(coupling == "penalty",
-              "parachute_drop: --mesh blocks runs the penalty coupling only so far (the "
-              "embedded coupling's face patches are not on the block mesh yet); add --coupling penalty");
       require(viscosity != "constant", "parachute_drop: --mesh blocks is inviscid so far (no --viscosity constant)");
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
@@ -671,6 +668,13 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
         fl.fill_uniform(air);
         place_drop_box(fl, su.box, chute);
         if (parallel::max_threads() > 1) fl.set_threading(true);
+        if (c.coupling == "embedded") {
+          coupling::embedded_options eo;
+          eo.impedance = c.impedance;
+          using C = coupling::embedded<porosity::ergun>;
+          detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
+          return run.run(progress);
+        }
         coupling::penalty_options po;
         po.pfac = c.pfac;
         po.stiffening = c.stiffening;

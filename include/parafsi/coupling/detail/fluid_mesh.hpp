@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <variant>
 
 #include <Eigen/Core>
@@ -143,6 +144,101 @@ class mesh_locator {
 
  private:
   std::variant<grid_locator, block_locator> loc_;
+};
+
+namespace detail {
+
+/// Width of the smallest side of the fluid cell holding ξ (box coordinates; the nearest
+/// cell of the box grid, the leaf cell of a block mesh, the finest cell outside the box).
+template <class F>
+double local_width(const F& f, const Eigen::Vector3d& xi) {
+  if constexpr (block_fluid<F>) {
+    const auto& lay = f.layout();
+    const fluid::blocks::cell_address a = fluid::blocks::find_cell(f.tree(), lay, xi);
+    const int L = a.block < 0 ? f.tree().finest_level() : a.level;
+    return std::min({lay.cell_width(0, L), lay.cell_width(1, L), lay.cell_width(2, L)});
+  } else {
+    const fluid::rectilinear_grid& g = f.grid();
+    double h = std::numeric_limits<double>::infinity();
+    for (int d = 0; d < 3; ++d) {
+      if (g.n(d) <= 1) continue;
+      index_t lo = 0, hi = g.n(d) - 1;  // last cell whose low face is <= xi_d
+      while (lo < hi) {
+        const index_t mid = (lo + hi + 1) / 2;
+        if (g.face(d, mid) <= xi[d]) lo = mid;
+        else hi = mid - 1;
+      }
+      h = std::min(h, g.width(d, lo));
+    }
+    return std::isfinite(h) ? h : g.min_width();
+  }
+}
+
+}  // namespace detail
+
+/// Where a coupling finds the faces a membrane crosses (coupling::embedded): an index grid
+/// whose cells and faces it tests, and the fluid cell of each index-grid cell. On the box
+/// solver the index grid is the box's grid and a cell is its own flat index; on a block
+/// mesh it is the uniform grid of the finest level over the whole box (axes only, no
+/// storage), whose cell (I, J, K) is cell I mod n of the finest-level block ⌊I/n⌋ if that
+/// block is a leaf, else none (−1): a membrane must lie on the finest level.
+class face_space {
+ public:
+  face_space() = default;
+  template <class F>
+  static face_space of(const F& f) {
+    face_space s;
+    if constexpr (block_fluid<F>) {
+      const auto& lay = f.layout();
+      const int L = f.tree().finest_level();
+      std::array<index_t, 3> N{};
+      for (int d = 0; d < 3; ++d) N[std::size_t(d)] = f.tree().extent(d, L) * lay.block_cells;
+      s.own_ = fluid::rectilinear_grid::uniform(N, lay.lo, lay.hi);
+      s.grid_ = &s.own_;
+      s.tree_ = &f.tree();
+      s.n_ = lay.block_cells;
+      s.stride_ = f.stride();
+      s.level_ = L;
+    } else {
+      s.grid_ = &f.grid();
+    }
+    return s;
+  }
+  face_space(const face_space& o) { *this = o; }
+  face_space& operator=(const face_space& o) {
+    if (this == &o) return *this;
+    own_ = o.own_;
+    grid_ = o.grid_ == &o.own_ ? &own_ : o.grid_;
+    tree_ = o.tree_;
+    n_ = o.n_;
+    stride_ = o.stride_;
+    level_ = o.level_;
+    return *this;
+  }
+
+  const fluid::rectilinear_grid& grid() const noexcept { return *grid_; }
+  bool blocks() const noexcept { return tree_ != nullptr; }
+  /// Fluid cell (flat index of the fluid's arrays) of index-grid cell c; −1: none.
+  index_t cell(index_t c) const {
+    if (!tree_) return c;
+    const auto I = grid_->ijk(c);
+    fluid::blocks::location q{level_, {}};
+    std::array<index_t, 3> loc{};
+    for (int d = 0; d < 3; ++d) {
+      q.l[std::size_t(d)] = I[std::size_t(d)] / n_;
+      loc[std::size_t(d)] = I[std::size_t(d)] % n_;
+    }
+    const index_t id = tree_->id_of(q);
+    if (id < 0) return -1;
+    return id * stride_ + fluid::blocks::block_index{n_}(loc[0], loc[1], loc[2]);
+  }
+
+ private:
+  fluid::rectilinear_grid own_{};
+  const fluid::rectilinear_grid* grid_ = nullptr;
+  const fluid::blocks::tree* tree_ = nullptr;
+  index_t n_ = 0, stride_ = 0;
+  int level_ = 0;
 };
 
 namespace detail {

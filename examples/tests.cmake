@@ -184,10 +184,11 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "hist
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"
   "5|1|1280" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --coupling penalty --block-size 4
   --slice-times 0.01 --vtk-every 0.01 --quiet)
-# The block mesh with the embedded coupling (the default coupling): the tiny scene for 20 ms.
-parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_drop "history.csv|summary.csv"
-  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
-  "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --quiet)
+# The block mesh with the embedded coupling (the default coupling): the tiny scene for 20 ms
+# with its mesh.csv (the first mesh and the regrid at step 10 that changed it).
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_drop "history.csv|summary.csv|mesh.csv"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
+  "5|1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --quiet)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)

@@ -51,9 +51,9 @@ void block_window(const S& s, double a, double b, double& p, double& u, int& lmi
   s.fluid().for_each_cell([&](const auto& blk, pf::index_t i, pf::index_t j, pf::index_t k) {
     const double x = blk.grid.centre(0, i);
     if (x <= a || x >= b) return;
-    const auto w = pf::fluid::to_prim(
-        pf::fluid::detail::load_cons(pf::fluid::detail::conserved_ptrs(blk.U), blk.grid.index(i, j, k)),
-        s.fluid().gas());
+    const auto w = pf::fluid::to_prim(pf::fluid::detail::load_cons(pf::fluid::detail::conserved_ptrs(blk.U),
+                                                                   blk.grid.index(i, j, k)),
+                                      s.fluid().gas());
     const double v = blk.grid.cell_volume(i, j, k);
     p += w.p * v;
     u += w.u.x * v;
@@ -88,9 +88,10 @@ TEST_CASE("embedded piston across a level boundary: the exact piston shock, no l
   int lmin, lmax;
   block_window(s, xp + 0.2 * (xf - xp), xp + 0.8 * (xf - xp), p, u, lmin, lmax);
   const double e_exact = (p - p0) / exact - 1.0;
-  std::printf("embedded piston on blocks (levels %d-%d in the window): dp = %.2f Pa, exact shock %.2f Pa (%+.3f %%), "
-              "u_air = %.5f m/s\n",
-              lmin, lmax, p - p0, exact, 100 * e_exact, u);
+  std::printf(
+      "embedded piston on blocks (levels %d-%d in the window): dp = %.2f Pa, exact shock %.2f Pa (%+.3f %%), "
+      "u_air = %.5f m/s\n",
+      lmin, lmax, p - p0, exact, 100 * e_exact, u);
   CHECK(lmin == 0);
   CHECK(lmax == 1);
   CHECK(std::fabs(e_exact) < 0.005);
@@ -117,9 +118,10 @@ TEST_CASE("embedded porous screen across level boundaries: the pressure drop on 
     block_window(s, xs - 0.2, xs - 0.1, pu, uu, l0, l1);
     block_window(s, xs + 0.1, xs + 0.2, pd, ud, m0, m1);
     const double dp = pu - pd, ergun = law.pressure_jump(uu), err = dp / ergun - 1.0;
-    std::printf("screen on blocks %-9s (probe levels %d-%d, %d-%d): through %.5g m/s, dp %7.2f Pa, Ergun %7.2f Pa, "
-                "error %+.3f %%\n",
-                std::string(fab.name).c_str(), l0, l1, m0, m1, uu, dp, ergun, 100 * err);
+    std::printf(
+        "screen on blocks %-9s (probe levels %d-%d, %d-%d): through %.5g m/s, dp %7.2f Pa, Ergun %7.2f Pa, "
+        "error %+.3f %%\n",
+        std::string(fab.name).c_str(), l0, l1, m0, m1, uu, dp, ergun, 100 * err);
     CHECK(s.fluid().tree().finest_level() == 1);
     CHECK(l1 == 0);
     CHECK(m1 == 0);

@@ -73,6 +73,7 @@
 #include "../fluid/fluid.hpp"
 #include "../io/block_vtk.hpp"
 #include "../io/checkpoint.hpp"
+#include "../io/csv.hpp"
 #include "../io/drop_history.hpp"
 #include "../io/drop_slice.hpp"
 #include "../io/drop_summary.hpp"
@@ -226,6 +227,10 @@ struct drop_result {
   io::drop_summary summary;
   long cells = 0, nodes = 0, triangles = 0, steps = 0;
   double substeps_per_step = 0, wall = 0;
+  /// Block mesh: leaf cells averaged over the steps, the most at any step, and the regrids
+  /// that changed the mesh (the tensor box: its cell count, the same, 0).
+  double mean_cells = 0;
+  long max_cells = 0, regrids = 0;
   stepper_phase_times times{};
 };
 
@@ -402,12 +407,21 @@ class drop_run {
     res.substeps_per_step = double(substeps) / double(std::max(1L, s_.steps()));
     res.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     res.times = s_.timings();
+    res.mean_cells = counted_steps_ ? cell_steps_ / double(counted_steps_) : double(res.cells);
+    res.max_cells = std::max(res.cells, max_cells_);
+    res.regrids = regrids_;
+    if (mesh_csv_) mesh_csv_->close();
     if (!c_.quiet)
       std::fprintf(stderr,
                    "parachute_drop: %ld fluid steps, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
                    "exchange %.1f, structure %.1f, fluid %.1f)\n",
                    res.steps, res.substeps_per_step, res.wall, res.times.move_frame, res.times.exchange,
                    res.times.structure, res.times.fluid);
+    if (!c_.quiet && block_mesh)
+      std::fprintf(stderr,
+                   "parachute_drop: block mesh: %.0f leaf cells on average over the steps, %ld at most, %ld regrids "
+                   "changed it (mesh.csv)\n",
+                   res.mean_cells, res.max_cells, res.regrids);
     io::summary_options so;
     so.force_cutoff = c_.force_cutoff;
     so.sample_interval = c_.history_every;
@@ -461,6 +475,10 @@ class drop_run {
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
       s_.step(dt);
+      if constexpr (block_mesh) {
+        cell_steps_ += double(s_.fluid().cell_count());
+        ++counted_steps_;
+      }
       substeps += s_.last_substeps();
       if (s_.time() >= next_out - 1e-9 * c_.history_every || s_.time() >= c_.t_end - 1e-12) {
         record(history);
@@ -503,6 +521,14 @@ class drop_run {
   void open_outputs() {
     if (!files_) return;
     hist_.emplace(out() / "history.csv");
+    if constexpr (block_mesh) {
+      // mesh.csv: the block mesh after every regrid that changed it.
+      std::vector<std::string> cols{"t", "step", "blocks", "cells"};
+      for (int l = 0; l <= levels_; ++l) cols.push_back("cells_level_" + std::to_string(l));
+      io::csv_options mo;
+      if (!c_.restart.empty()) mo.resume_after = s_.time();
+      mesh_csv_.emplace(out() / "mesh.csv", std::move(cols), mo);
+    }
     if (c_.vtk_every > 0) {
       std::filesystem::create_directories(out() / "vtk");
       pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
@@ -562,12 +588,27 @@ class drop_run {
                          structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
   }
 
-  /// Block mesh: refine to the canopy's current place (drop_block_target).
+  /// Block mesh: refine to the canopy's current place (drop_block_target); a row of
+  /// mesh.csv when the mesh changed (and for the first mesh).
   void regrid() {
-    if constexpr (block_mesh)
-      s_.fluid().regrid(drop_block_target(s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
-                                          su_.scene.triangles, levels_, c_.refine_every),
-                        levels_);
+    if constexpr (block_mesh) {
+      const bool changed = s_.fluid().regrid(drop_block_target(s_.fluid(), s_.structure().node_set(),
+                                                               su_.scene.canopy_nodes, su_.scene.triangles, levels_,
+                                                               c_.refine_every),
+                                             levels_);
+      if (!changed && mesh_rows_ > 0) return;
+      if (changed) ++regrids_;
+      max_cells_ = std::max(max_cells_, long(s_.fluid().cell_count()));
+      if (!mesh_csv_) return;
+      std::vector<double> row{s_.time(), double(s_.steps()), double(s_.fluid().block_count()),
+                              double(s_.fluid().cell_count())};
+      row.resize(row.size() + std::size_t(levels_ + 1), 0.0);
+      const double per_block = double(s_.fluid().block_cells()) * double(s_.fluid().block_cells()) *
+                               double(s_.fluid().block_cells());
+      for (const auto& q : s_.fluid().tree().leaves()) row[4 + std::size_t(q.level)] += per_block;
+      mesh_csv_->row(row);
+      ++mesh_rows_;
+    }
   }
 
   /// Pressure of a corner cell of the box (the restart's check of the ambient).
@@ -606,7 +647,10 @@ class drop_run {
                               -1, s_.time());
   }
 
-  int levels_ = 0;  ///< block mesh: the finest level
+  int levels_ = 0;                          ///< block mesh: the finest level
+  std::optional<io::csv_writer> mesh_csv_;  ///< block mesh: mesh.csv
+  long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
+  double cell_steps_ = 0;  ///< Σ over steps of the leaf cells
   const drop_config& c_;
   const drop_setup& su_;
   stepper_type s_;

@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 1000.0));
   app.add_option("--mesh", c.mesh,
                  "fluid mesh: tensor (the refined rectilinear box) or blocks (block-structured, refined to the "
-                 "canopy; inviscid so far)")
+                 "canopy)")
       ->check(CLI::IsMember({"tensor", "blocks"}))
       ->capture_default_str();
   app.add_option("--block-size", c.block_size, "blocks: cells per block edge (even, 4-64)")

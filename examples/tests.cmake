@@ -189,6 +189,10 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "hist
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_drop "history.csv|summary.csv|mesh.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
   "5|1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --quiet)
+# ... and with the air's laminar viscosity.
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_viscous parachute_drop "history.csv|summary.csv"
+  "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --viscosity constant --quiet)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)
@@ -257,9 +261,7 @@ foreach(flag IN ITEMS t-end history-every force-cutoff box-width box-length box-
 endforeach()
 parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
   --t-end inf)
-# The block mesh's limits so far, named.
-parafsi_example_refuses(example_parachute_drop_blocks_viscous parachute_drop "" "--mesh blocks is inviscid so far"
-  --mesh blocks --viscosity constant)
+# The block mesh's limits, named.
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
 # The bundle's mouth diameter outside [0.01, 0.5] D0 (a smaller one would leave elements of ≈ d/D0 of their area).

@@ -51,6 +51,7 @@
 #include "detail/stage.hpp"
 #include "detail/sweep.hpp"
 #include "detail/update.hpp"
+#include "detail/viscous.hpp"
 #include "fields.hpp"
 #include "flux/ale.hpp"
 #include "flux/hllc_lm.hpp"
@@ -76,10 +77,14 @@ class block_solver {
   using recon_type = Recon;
   using frame_type = Frame;
   using time_type = Time;
+  using turbulence_type = Turbulence;
+  using viscosity_type = Viscosity;
   static constexpr bool is_viscous = Viscosity::active || Turbulence::active;
-  static_assert(!is_viscous,
-                "fluid::block_solver: viscous and turbulent closures need the coarse-fine correction "
-                "of their fluxes, not available yet; use fluid::solver");
+  static_assert(!Turbulence::active,
+                "fluid::block_solver: eddy-viscosity (turbulence) closures are not on the block mesh yet; laminar "
+                "viscosity is (fluid::solver has both)");
+  /// Per-thread scratch of the viscous pass (one block at a time), none when inviscid.
+  using viscous_storage = std::conditional_t<is_viscous, soa_of_t<viscous_fields>, empty_storage>;
   static constexpr index_t ng = rectilinear_grid::ghosts;
   using cons_storage = soa_of_t<conserved_fields>;
   using prim_storage = soa_of_t<primitive_fields>;
@@ -124,9 +129,11 @@ class block_solver {
         gas_(pick_value<kind::gas, gas::ideal>(policies...)),
         flux_(pick_value<kind::flux, Flux>(policies...)),
         recon_(pick_value<kind::reconstruction, Recon>(policies...)),
+        visc_(pick_value<kind::viscosity, Viscosity>(policies...)),
         frame_(pick_value<kind::frame, Frame>(policies...)) {
     layout_.validate();
     gas_.validate();
+    if constexpr (requires { visc_.validate(); }) visc_.validate();
     bc_.validate();
     for (int d = 0; d < 3; ++d) {
       const bool plo = std::holds_alternative<boundary::periodic>(bc_.face[std::size_t(2 * d)]);
@@ -298,9 +305,8 @@ class block_solver {
     rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
     detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
-      rate_[std::size_t(id)] = detail::max_wave_rate<false>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
-                                                            viscosity::inviscid{}, turbulence::none{}, nullptr, cfl,
-                                                            b.rate_slots, false);
+      rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
+                                                                 visc_, turb_, nullptr, cfl, b.rate_slots, false);
     });
     double lam = 0.0;
     for (double r : rate_) lam = std::max(lam, r);
@@ -546,6 +552,12 @@ class block_solver {
     // One buffer set per thread of the block loop, handed to the serial kernels inside.
     bufs_.resize(std::size_t(parallel::max_threads()));
     for (auto& set : bufs_) detail::ensure_row_buffers(set, n_);
+    if constexpr (is_viscous) {
+      const index_t cells = blocks_[0].grid.total_cells();
+      if (visc_bufs_.size() < bufs_.size()) visc_bufs_.resize(bufs_.size());
+      for (auto& vs : visc_bufs_)
+        if (vs.size() < cells) vs.resize(cells, 0.0);
+    }
     timed(times_.fluxes, [&] {
       detail::par_for(threaded_, 0, nb, [&](index_t id) {
         block& b = blocks_[std::size_t(id)];
@@ -558,12 +570,43 @@ class block_solver {
         detail::sweep<0>(fk, geo, dU, bufs, false, register_of(b, 0));
         detail::sweep<1>(fk, geo, dU, bufs, false, register_of(b, 1));
         detail::sweep<2>(fk, geo, dU, bufs, false, register_of(b, 2));
+        if constexpr (is_viscous) add_viscous(b, geo, visc_bufs_[std::size_t(parallel::thread_id())]);
       });
       detail::par_for(threaded_, 0, nb, [&](index_t id) { correct_fluxes(id); });
     });
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
       timed(times_.sources, [&] { detail::par_for(threaded_, 0, nb, [&](index_t id) { add_sources(id); }); });
+  }
+
+  /// The viscous and heat fluxes of block b (detail/viscous.hpp, on the block's grid with its
+  /// ghost layers) added to its rates; its boundary faces' fluxes are taken off the face
+  /// register, which then holds the total flux F − F_v that the coarse–fine correction
+  /// replaces (so the viscous flux is corrected too and conservation holds across levels).
+  void add_viscous(block& b, const detail::stage_geometry& geo, viscous_storage& vs) {
+    const auto W = detail::primitive_ptrs(std::as_const(b.W));
+    const auto dU = detail::conserved_ptrs(b.dU);
+    const index_t n = n_;
+    auto keep = [&](int d, double* const* Fv) {
+      const detail::face_register reg = register_of(b, d);
+      const int a1 = d == 0 ? 1 : 0, a2 = d == 2 ? 1 : 2;  // transverse axes, register order
+      for (index_t q = 0; q < n; ++q)
+        for (index_t p = 0; p < n; ++p) {
+          index_t lo[3], hi[3];
+          lo[a1] = hi[a1] = p;
+          lo[a2] = hi[a2] = q;
+          lo[d] = 0;
+          hi[d] = n;
+          const index_t r = p + n * q, cl = b.grid.index(lo[0], lo[1], lo[2]), ch = b.grid.index(hi[0], hi[1], hi[2]);
+          for (int f = 1; f < 5; ++f) {
+            reg.lo[f][r] -= Fv[f - 1][cl];
+            reg.hi[f][r] -= Fv[f - 1][ch];
+          }
+        }
+    };
+    detail::viscous_pass<Viscosity, Turbulence, viscous_storage, empty_storage>{visc_, turb_,    gas_, b.grid,
+                                                                                vs,    no_turb_, false}(geo, W, dU,
+                                                                                                        keep);
   }
 
   /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp, first-
@@ -808,6 +851,8 @@ class block_solver {
   gas::ideal gas_;
   Flux flux_;
   Recon recon_;
+  [[no_unique_address]] Turbulence turb_{};
+  Viscosity visc_;
   Frame frame_;
   frame::pose pose_{};
   double t_ = 0.0;
@@ -822,6 +867,8 @@ class block_solver {
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;
   std::vector<std::vector<detail::row_buffers>> bufs_;  ///< per thread of the block loop
+  std::vector<viscous_storage> visc_bufs_;              ///< per thread of the block loop (viscous)
+  [[no_unique_address]] empty_storage no_turb_{};
   bool sources_on_ = false;
   mutable std::vector<double> rate_;  ///< stable_dt's per-block maxima
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};

@@ -92,7 +92,7 @@ struct drop_config {
   std::string fabric = "mat544";      ///< paper canopy: mat544 | mat59225 | mat509
   std::string resolution = "coarse";  ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
   std::string coupling = "embedded";  ///< embedded | penalty
-  std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh (inviscid)
+  std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh
   int block_size = 8;                 ///< blocks: cells per block edge
   int refine_every = 5;               ///< blocks: regrid to the canopy every this many steps
   std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
@@ -139,7 +139,6 @@ struct drop_config {
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
     if (mesh == "blocks") {
-      require(viscosity != "constant", "parachute_drop: --mesh blocks is inviscid so far (no --viscosity constant)");
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
@@ -300,7 +299,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
   const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
-  su.viscous = c.mesh != "blocks" && !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
+  su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
 }
 
@@ -703,30 +702,28 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   return detail::with_fluid_policies(su, [&](auto visc, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
     const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
-    if constexpr (std::is_same_v<decltype(visc), viscosity::inviscid>) {
-      if (c.mesh == "blocks") {
-        // The block mesh: one level to start with, refined to the canopy before the first step.
-        const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
-        fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc, flux::hllc_lm{},
-                               recon::muscl<limiter::van_leer>{},    frame};
-        fl.fill_uniform(air);
-        place_drop_box(fl, su.box, chute);
-        if (parallel::max_threads() > 1) fl.set_threading(true);
-        if (c.coupling == "embedded") {
-          coupling::embedded_options eo;
-          eo.impedance = c.impedance;
-          using C = coupling::embedded<porosity::ergun>;
-          detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
-          return run.run(progress);
-        }
-        coupling::penalty_options po;
-        po.pfac = c.pfac;
-        po.stiffening = c.stiffening;
-        po.damping_ratio = c.coupling_damping;
-        using C = coupling::penalty<porosity::ergun>;
-        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
+    if (c.mesh == "blocks") {
+      // The block mesh: one level to start with, refined to the canopy before the first step.
+      const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
+      fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,   flux::hllc_lm{},
+                             recon::muscl<limiter::van_leer>{},    visc, frame};
+      fl.fill_uniform(air);
+      place_drop_box(fl, su.box, chute);
+      if (parallel::max_threads() > 1) fl.set_threading(true);
+      if (c.coupling == "embedded") {
+        coupling::embedded_options eo;
+        eo.impedance = c.impedance;
+        using C = coupling::embedded<porosity::ergun>;
+        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
         return run.run(progress);
       }
+      coupling::penalty_options po;
+      po.pfac = c.pfac;
+      po.stiffening = c.stiffening;
+      po.damping_ratio = c.coupling_damping;
+      using C = coupling::penalty<porosity::ergun>;
+      detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
+      return run.run(progress);
     }
     fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, frame};
     fl.initialize([&](const Eigen::Vector3d&) { return air; });

@@ -20,6 +20,13 @@
 
 namespace parafsi::fluid::detail {
 
+/// What the viscous pass does with an axis's face fluxes besides differencing them: nothing
+/// (the box solver); a block of a block mesh keeps its boundary faces' for the coarse–fine
+/// correction (hook(d, Fv): Fv[q][c] the flux of the face below cell c, q = momentum x, y, z, energy).
+struct no_face_hook {
+  void operator()(int, double* const*) const noexcept {}
+};
+
 /// Everything the viscous pass reads and writes.
 template <class Viscosity, class Turbulence, class ViscStorage, class TurbStorage>
 struct viscous_pass {
@@ -37,7 +44,9 @@ struct viscous_pass {
   TurbStorage& ts;
   bool threaded;
 
-  void operator()(const stage_geometry& geo, const fields5<const double>& W, const fields5<double>& dU) {
+  template <class FaceHook = no_face_hook>
+  void operator()(const stage_geometry& geo, const fields5<const double>& W, const fields5<double>& dU,
+                  const FaceHook& hook = {}) {
     const index_t nx = grid.n(0), ny = grid.n(1), nz = grid.n(2);
     double* ub[3] = {vs.template get<field::ub0>(), vs.template get<field::ub1>(), vs.template get<field::ub2>()};
     double* Tc = vs.template get<field::T>();
@@ -137,6 +146,7 @@ struct viscous_pass {
             face(d, c - s, c, idc[ijk[d]], c);
           }
       });
+      hook(d, Fv);
       par_for(threaded, 0, nz, [&](index_t k) {
         for (index_t j = 0; j < ny; ++j)
           for (index_t i = 0; i < nx; ++i) {

@@ -1,0 +1,124 @@
+// Laminar viscosity on the block mesh (fluid::block_solver with viscosity::constant): one
+// level reproduces the box solver's viscous run to round-off (the viscous pass runs on each
+// block with its ghost layers, and its stable step includes the viscous limit); across a
+// level boundary the viscous fluxes are corrected with the inviscid ones, so mass,
+// momentum and energy are conserved to round-off, and a shear wave u_y = U sin(kx), whose
+// amplitude decays as exp(−ν k² t) (the transverse momentum diffuses; exact for the
+// linearised compressible equations), decays at that rate through a band one level finer.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "fluid_test_util.hpp"
+
+using namespace parafsi;
+namespace fb = parafsi::fluid::blocks;
+
+namespace {
+constexpr double rho0 = 1.0, p0 = 1.0;  // c ≈ 1.18 m/s: viscous and acoustic steps alike
+
+/// Largest relative difference of the conserved state between a block mesh and a box solver
+/// on the same uniform cells.
+template <class B, class S>
+double max_difference(const B& blk, const S& box) {
+  double e = 0;
+  blk.for_each_cell([&](const auto& b, index_t i, index_t j, index_t k) {
+    const auto q = fluid::detail::load_cons(fluid::detail::conserved_ptrs(b.U), b.grid.index(i, j, k));
+    const auto& g = box.grid();
+    index_t I[3];
+    const double x[3] = {b.grid.centre(0, i), b.grid.centre(1, j), b.grid.centre(2, k)};
+    for (int d = 0; d < 3; ++d) {
+      const double h = (g.face(d, g.n(d)) - g.face(d, 0)) / double(g.n(d));
+      I[d] = index_t(std::floor((x[d] - g.face(d, 0)) / h));
+    }
+    const auto r = box.conserved(I[0], I[1], I[2]);
+    const double scale = std::fabs(r.E) + std::fabs(r.rho);
+    e = std::max({e, std::fabs(q.rho - r.rho) / scale, std::fabs(q.m.x - r.m.x) / scale,
+                  std::fabs(q.m.y - r.m.y) / scale, std::fabs(q.m.z - r.m.z) / scale, std::fabs(q.E - r.E) / scale});
+  });
+  return e;
+}
+}  // namespace
+
+TEST_CASE("viscous block mesh: one level reproduces the box solver to round-off, viscous step limit included") {
+  const double pi2 = 2.0 * std::numbers::pi;
+  viscosity::constant mu;
+  mu.mu_value = 0.05;  // the viscous step limit h²/(12 ν) binds on the 1/16 m cells
+  const auto bc = boundary::set::all(boundary::periodic{});
+  fluid::block_layout lay{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, 8};
+  fluid::block_solver blk{fb::tree({2, 2, 2}, {true, true, true}), lay, bc, mu};
+  fluid::solver box{fluid::rectilinear_grid::uniform({16, 16, 16}, lay.lo, lay.hi), bc, mu};
+  auto field = [&](const Eigen::Vector3d& x) {
+    return fluid::prim<double>{rho0 * (1.0 + 0.1 * std::sin(pi2 * (x[0] + x[2]))),
+                               {0.05 * std::sin(pi2 * x[1]), 0.05 * std::sin(pi2 * x[2]), 0.05 * std::sin(pi2 * x[0])},
+                               p0 * (1.0 + 0.05 * std::cos(pi2 * x[1]))};
+  };
+  blk.initialize(field);
+  box.initialize(field);
+  const double dt_blk = blk.stable_dt(0.5), dt_box = box.stable_dt(0.5);
+  double worst = 0;
+  for (int n = 0; n < 20; ++n) {
+    const double dt = box.stable_dt(0.5);
+    box.step(dt);
+    blk.step(dt);
+    worst = std::max(worst, max_difference(blk, box));
+  }
+  // The inviscid step of the same state, to show the viscous limit is the one that binds.
+  fluid::solver inv{fluid::rectilinear_grid::uniform({16, 16, 16}, lay.lo, lay.hi), bc};
+  inv.initialize(field);
+  MESSAGE("20 viscous steps (mu 0.05 Pa s): max relative state difference ", worst, "; stable dt blocks ", dt_blk,
+          " s, box ", dt_box, " s, inviscid box ", inv.stable_dt(0.5), " s");
+  CHECK(worst < 1e-14);
+  CHECK(dt_blk == doctest::Approx(dt_box).epsilon(1e-14));
+  CHECK(dt_box < 0.9 * inv.stable_dt(0.5));
+}
+
+TEST_CASE("viscous block mesh across a level boundary: conservation to round-off and the shear wave's decay") {
+  const double pi2 = 2.0 * std::numbers::pi, U = 0.01, L = 1.0, k = pi2 / L;
+  viscosity::constant mu;
+  mu.mu_value = 0.01;
+  const double nu = mu.mu_value / rho0;
+  // A periodic 1 x 0.25 x 0.25 m box of 4 root blocks of 8^3 (h = 1/32 m); the second refined
+  // once (x in [0.25, 0.5], h = 1/64 m), so the wave crosses two level boundaries.
+  fluid::block_layout lay{{0, 0, 0}, {L, 0.25, 0.25}, {4, 1, 1}, 8};
+  fb::tree t({4, 1, 1}, {true, true, true});
+  t.refine_where(1, [](const fb::location& q) { return q.level == 0 && q.l[0] == 1; });
+  fluid::block_solver s{t, lay, boundary::set::all(boundary::periodic{}), mu};
+  s.initialize([&](const Eigen::Vector3d& x) {
+    return fluid::prim<double>{rho0, {0.0, U * std::sin(k * x[0]), 0.0}, p0};
+  });
+  auto amplitude = [&] {  // projection of u_y on sin(kx) over the leaf cells
+    double a = 0, b = 0;
+    s.for_each_cell([&](const auto& blk, index_t i, index_t j, index_t kk) {
+      const auto w = fluid::to_prim(
+          fluid::detail::load_cons(fluid::detail::conserved_ptrs(blk.U), blk.grid.index(i, j, kk)), s.gas());
+      const double sn = std::sin(k * blk.grid.centre(0, i)), v = blk.grid.cell_volume(i, j, kk);
+      a += w.u.y * sn * v;
+      b += sn * sn * v;
+    });
+    return a / b;
+  };
+  const double a0 = amplitude();
+  const auto t0 = s.totals();
+  double worst_m = 0, worst_p = 0, worst_e = 0;
+  const double t_end = 0.5;
+  while (s.time() < t_end - 1e-12) {
+    s.step(std::min(s.stable_dt(0.5), t_end - s.time()));
+    const auto t1 = s.totals();
+    worst_m = std::max(worst_m, std::fabs(t1.mass - t0.mass) / t0.mass);
+    worst_e = std::max(worst_e, std::fabs(t1.energy - t0.energy) / t0.energy);
+    for (int d = 0; d < 3; ++d)
+      worst_p = std::max(worst_p, std::fabs(t1.momentum[std::size_t(d)] - t0.momentum[std::size_t(d)]) /
+                                      (rho0 * U * t0.mass / rho0));
+  }
+  const double decay = amplitude() / a0, exact = std::exp(-nu * k * k * t_end);
+  MESSAGE(s.block_count(), " blocks, levels 0-1, ", s.steps(), " steps to t = ", t_end, " s: amplitude ratio ", decay,
+          ", exact exp(-nu k^2 t) = ", exact, " (error ", 100 * (decay / exact - 1), " %); conservation: mass ",
+          worst_m, ", momentum ", worst_p, " (of rho U V), energy ", worst_e);
+  CHECK(s.tree().finest_level() == 1);
+  CHECK(decay == doctest::Approx(exact).epsilon(5e-3));
+  CHECK(worst_m < 1e-13);
+  CHECK(worst_p < 1e-12);
+  CHECK(worst_e < 1e-13);
+}

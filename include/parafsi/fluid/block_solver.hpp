@@ -7,8 +7,10 @@
 /// levels (the membranes sit on the finest level, which sets the step anyway); every
 /// Runge–Kutta stage is the recipe
 ///   exchange ghosts (copy · restrict · prolong, blocks/exchange.hpp) → boundary ghosts →
-///   primitives → three flux sweeps per block, keeping boundary-face fluxes →
-///   coarse–fine flux correction (blocks/flux_correction.hpp) → update,
+///   primitives → three flux sweeps per block, keeping boundary-face fluxes → viscous
+///   pass (with a viscosity policy; its boundary-face fluxes join the kept ones) →
+///   coarse–fine flux correction (blocks/flux_correction.hpp) → the coupling's face
+///   patches → sources and sponge → update,
 /// which conserves mass, momentum and energy to round-off across levels. Blocks run in
 /// parallel (OpenMP) with serial kernels inside, so results do not depend on the thread
 /// count.
@@ -17,8 +19,9 @@
 /// time policies are those of solver.hpp, and so are the optional per-cell sources (held
 /// constant over a step) and the far-field sponge: σ = s c_∞/L_s ((L − d)/L)³ with d the
 /// cell centre's distance from a far-field face in root-level cells less ½ and L_s = L
-/// root-level cells, which is the box solver's layer on a one-level mesh. Inviscid only
-/// for now (the viscous pass would need its own coarse–fine flux correction).
+/// root-level cells, which is the box solver's layer on a one-level mesh. Laminar viscosity
+/// and heat conduction (viscosity::constant …) run per block; eddy-viscosity closures are
+/// not on the block mesh yet (refused at compile time).
 ///
 /// References: Berger M.J., Colella P. (1989) J. Comput. Phys. 82:64;
 ///   Stone J.M. et al. (2020) ApJS 249:4 (Athena++); Zhang W. et al. (2019) JOSS 4:1370 (AMReX).

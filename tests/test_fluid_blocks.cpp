@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <parafsi/io/checkpoint.hpp>
 
 #include "fluid_test_util.hpp"
@@ -382,6 +383,55 @@ TEST_CASE("regrid: the refined region follows a moving vortex, conserving to rou
   const auto ex = ve(ve.cx, ve.cy);
   MESSAGE("pressure at the vortex centre: ", w.p, " (exact ", ex.p, ")");
   CHECK(w.p == doctest::Approx(ex.p).epsilon(0.05));
+}
+
+TEST_CASE("flow criterion: the vorticity indicator refines the blocks holding a moving vortex and follows it") {
+  fluid::block_layout lay{{0, 0, 0}, {10, 10, 2.5}, {4, 4, 1}, 8};
+  fluid::reference::isentropic_vortex v{};
+  v.cx = 3.0;
+  v.cy = 4.0;
+  v.u_inf = 2.0;
+  v.v_inf = 1.0;
+  v.period = 10.0;
+  fluid::block_solver s{fb::tree({4, 4, 1}, {true, true, true}), lay, boundary::set::all(boundary::periodic{}),
+                        recon::muscl<limiter::mc>{}};
+  s.initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+  // |ω| = a (2 − r²), a = ε/(2π) exp((1 − r²)/2): the core's ω = (ε/π) e^{1/2}; times h.
+  const double h = lay.cell_width(0, 0), peak = v.eps / std::numbers::pi * std::exp(0.5) * h;
+  const std::vector<double> ind0 = s.vorticity_indicator();
+  const double top = *std::max_element(ind0.begin(), ind0.end());
+  MESSAGE("largest |omega| h over the root blocks ", top, " m/s; the core's exact value ", peak, " m/s");
+  // No cell centre sits on the core (offsets 0.03 and 0.09 m): within 10 % below the peak.
+  CHECK(top / peak > 0.9);
+  CHECK(top / peak < 1.0);
+  // Refine where |ω| h > 0.3 m/s, coarsen below 0.1 m/s, up to level 1.
+  auto criterion = [&] { return fb::leaf_indicator(s.tree(), s.vorticity_indicator(), 0.3, 0.1, 1); };
+  CHECK(s.regrid(criterion(), 1));
+  s.initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+  auto level_at = [&](double t) {
+    const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
+    return s.tree().leaf(s.locate(c).first).level;
+  };
+  const index_t blocks0 = s.block_count();
+  CHECK(level_at(0.0) == 1);
+  CHECK(s.tree().leaf(s.locate({9.0, 9.0, 1.25}).first).level == 0);  // far from the core
+  const auto t0 = s.totals();
+  int regrids = 0;
+  for (int n = 0; n < 60; ++n) {
+    s.step(s.stable_dt(0.5));
+    if (n % 5 == 4) regrids += s.regrid(criterion(), 1);
+  }
+  const auto t1 = s.totals();
+  MESSAGE(blocks0, " blocks after the first regrid (16 root blocks), ", s.block_count(), " at t = ", s.time(), " s after ",
+          regrids, " regrids; vortex centre moved by ", 2.0 * s.time() * std::sqrt(1.25), " m; mass change ",
+          std::fabs(t1.mass - t0.mass) / t0.mass);
+  CHECK(blocks0 > 16);
+  CHECK(blocks0 < 16 + 7 * 16);
+  CHECK(regrids >= 1);
+  CHECK(level_at(s.time()) == 1);
+  CHECK(std::fabs(t1.mass - t0.mass) / t0.mass < 2e-13);
+  CHECK_THROWS_AS(fb::leaf_indicator(s.tree(), std::vector<double>(3, 0.0), 0.3, 0.1, 1), invalid_input);
+  CHECK_THROWS_AS(fb::leaf_indicator(s.tree(), s.vorticity_indicator(), 0.1, 0.3, 1), invalid_input);
 }
 
 TEST_CASE("block mesh: the far-field sponge and sources match the box solver on one level") {

@@ -14,11 +14,20 @@
 ///
 /// Points are binned on a uniform grid of bins one buffer-plus-block wide, so a query
 /// looks at the few bins the block's box (grown by the buffer) overlaps.
+///
+///   leaf_indicator{tree, values, refine_above, coarsen_below, max_level}: a flow criterion
+///     from one value per leaf of the current tree (e.g. block_solver::vorticity_indicator,
+///     max |ω| h over the leaf, in m/s): a block whose leaf's value exceeds `refine_above`
+///     wants one level finer (up to max_level), one below `coarsen_below` one level coarser,
+///     else its level; a regrid thus moves a level at a time and the gap between the two
+///     thresholds keeps a refined block from coarsening at once (|ω| h halves when h does).
+///   max_of{a, b}: the finer of two criteria's targets.
 #pragma once
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -116,5 +125,46 @@ class near_points {
   double bin_ = 0;
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins_;
 };
+
+/// A flow criterion from one value per leaf of the current tree (see the file comment).
+class leaf_indicator {
+ public:
+  leaf_indicator(const tree& t, std::vector<double> values, double refine_above, double coarsen_below, int max_level)
+      : tree_(&t), values_(std::move(values)), hi_(refine_above), lo_(coarsen_below), max_level_(max_level) {
+    require(values_.size() == std::size_t(t.size()), "blocks::leaf_indicator: ", values_.size(), " values for ",
+            t.size(), " leaves");
+    require(std::isfinite(refine_above) && std::isfinite(coarsen_below) && coarsen_below >= 0 &&
+                coarsen_below < refine_above,
+            "blocks::leaf_indicator: need finite thresholds 0 <= coarsen_below < refine_above, got ", coarsen_below,
+            " and ", refine_above);
+    require(max_level >= 0 && max_level <= tree::max_depth, "blocks::leaf_indicator: max_level must be in [0, ",
+            tree::max_depth, "], got ", max_level);
+  }
+
+  int operator()(const location& q) const {
+    const cover c = tree_->find(q);
+    if (c.kind != cover::leaf) return q.level;  // outside, or coarser than today's leaves: keep
+    const double v = values_[std::size_t(c.id)];
+    if (v > hi_) return std::min(c.level + 1, max_level_);
+    if (v < lo_) return std::max(c.level - 1, 0);
+    return c.level;
+  }
+
+ private:
+  const tree* tree_;
+  std::vector<double> values_;
+  double hi_, lo_;
+  int max_level_;
+};
+
+/// The finer of two criteria's targets.
+template <class A, class B>
+struct max_of {
+  A a;
+  B b;
+  int operator()(const location& q) const { return std::max(int(a(q)), int(b(q))); }
+};
+template <class A, class B>
+max_of(A, B) -> max_of<A, B>;
 
 }  // namespace parafsi::fluid::blocks

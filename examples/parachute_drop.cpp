@@ -157,6 +157,12 @@ int main(int argc, char** argv) {
   app.add_option("--refine-every", c.refine_every, "blocks: regrid to the canopy every this many steps")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
+  app.add_option("--refine-vorticity", c.refine_vorticity,
+                 "blocks: also refine the wake where |vorticity| h exceeds this fraction of the payload speed "
+                 "(0: off)")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
   app.add_option("--element", c.element, "override: canopy element size / D0")
       ->check(finite)
       ->check(CLI::Range(0.0, 1.0));

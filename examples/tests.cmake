@@ -189,6 +189,10 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "hist
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_drop "history.csv|summary.csv|mesh.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
   "5|1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --quiet)
+# ... with the wake criterion (runs; the 20 ms wake stays inside the canopy's buffer: the mesh.csv rows of the plain run) ...
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_vorticity parachute_drop "summary.csv|mesh.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
+  "1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --refine-vorticity 0.02 --quiet)
 # ... and with the air's laminar viscosity.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_viscous parachute_drop "history.csv|summary.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
@@ -262,6 +266,8 @@ endforeach()
 parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
   --t-end inf)
 # The block mesh's limits, named.
+parafsi_example_refuses(example_parachute_drop_vorticity_tensor parachute_drop "" "--refine-vorticity needs --mesh blocks"
+  --refine-vorticity 0.1)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
 # The bundle's mouth diameter outside [0.01, 0.5] D0 (a smaller one would leave elements of ≈ d/D0 of their area).

@@ -422,9 +422,9 @@ TEST_CASE("flow criterion: the vorticity indicator refines the blocks holding a 
     if (n % 5 == 4) regrids += s.regrid(criterion(), 1);
   }
   const auto t1 = s.totals();
-  MESSAGE(blocks0, " blocks after the first regrid (16 root blocks), ", s.block_count(), " at t = ", s.time(), " s after ",
-          regrids, " regrids; vortex centre moved by ", 2.0 * s.time() * std::sqrt(1.25), " m; mass change ",
-          std::fabs(t1.mass - t0.mass) / t0.mass);
+  MESSAGE(blocks0, " blocks after the first regrid (16 root blocks), ", s.block_count(), " at t = ", s.time(),
+          " s after ", regrids, " regrids; vortex centre moved by ", 2.0 * s.time() * std::sqrt(1.25),
+          " m; mass change ", std::fabs(t1.mass - t0.mass) / t0.mass);
   CHECK(blocks0 > 16);
   CHECK(blocks0 < 16 + 7 * 16);
   CHECK(regrids >= 1);

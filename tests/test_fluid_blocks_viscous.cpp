@@ -91,8 +91,9 @@ TEST_CASE("viscous block mesh across a level boundary: conservation to round-off
   auto amplitude = [&] {  // projection of u_y on sin(kx) over the leaf cells
     double a = 0, b = 0;
     s.for_each_cell([&](const auto& blk, index_t i, index_t j, index_t kk) {
-      const auto w = fluid::to_prim(
-          fluid::detail::load_cons(fluid::detail::conserved_ptrs(blk.U), blk.grid.index(i, j, kk)), s.gas());
+      const auto w = fluid::to_prim(fluid::detail::load_cons(fluid::detail::conserved_ptrs(blk.U),
+                                                             blk.grid.index(i, j, kk)),
+                                    s.gas());
       const double sn = std::sin(k * blk.grid.centre(0, i)), v = blk.grid.cell_volume(i, j, kk);
       a += w.u.y * sn * v;
       b += sn * sn * v;

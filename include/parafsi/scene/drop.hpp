@@ -95,10 +95,13 @@ struct drop_config {
   std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh
   int block_size = 8;                 ///< blocks: cells per block edge
   int refine_every = 5;               ///< blocks: regrid to the canopy every this many steps
-  std::string viscosity = "auto";     ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
-  double t_end = 6.0;                 ///< simulated time (s)
-  double history_every = 0.005;       ///< output interval (s)
-  double force_cutoff = 10.0;         ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
+  /// blocks: also refine the wake where |ω| h > this × the payload's speed (the velocity
+  /// turning by that fraction across a cell; coarsened below a quarter of it); 0 = off
+  double refine_vorticity = 0;
+  std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
+  double t_end = 6.0;              ///< simulated time (s)
+  double history_every = 0.005;    ///< output interval (s)
+  double force_cutoff = 10.0;      ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
   double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
   double cfl = 0.9;   ///< CFL number of the fluid step
@@ -142,6 +145,10 @@ struct drop_config {
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
+      require(std::isfinite(refine_vorticity) && refine_vorticity >= 0 && refine_vorticity <= 10,
+              "parachute_drop: --refine-vorticity must be in [0, 10] (0: off), got ", refine_vorticity);
+    } else {
+      require(refine_vorticity == 0, "parachute_drop: --refine-vorticity needs --mesh blocks");
     }
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
@@ -325,7 +332,8 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   if (c.mesh == "blocks")
     g.add("mesh", c.mesh)
         .add("block_size", std::int64_t(c.block_size))
-        .add("refine_every", std::int64_t(c.refine_every));
+        .add("refine_every", std::int64_t(c.refine_every))
+        .add("refine_vorticity", c.refine_vorticity);
   return g;
 }
 
@@ -587,14 +595,26 @@ class drop_run {
                          structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
   }
 
-  /// Block mesh: refine to the canopy's current place (drop_block_target); a row of
-  /// mesh.csv when the mesh changed (and for the first mesh).
+  /// Block mesh: refine to the canopy's current place (drop_block_target) and, with
+  /// --refine-vorticity X, where the wake turns the velocity by more than X times the
+  /// payload's speed (at least 1 m/s) across a cell (blocks::leaf_indicator on
+  /// vorticity_indicator, one level per regrid); a row of mesh.csv when the mesh changed
+  /// (and for the first mesh).
   void regrid() {
     if constexpr (block_mesh) {
-      const bool changed = s_.fluid().regrid(drop_block_target(s_.fluid(), s_.structure().node_set(),
-                                                               su_.scene.canopy_nodes, su_.scene.triangles, levels_,
-                                                               c_.refine_every),
-                                             levels_);
+      auto& f = s_.fluid();
+      const auto near = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
+                                          levels_, c_.refine_every);
+      bool changed = false;
+      if (c_.refine_vorticity > 0) {
+        const double U = std::max(1.0, structure::payload(s_.structure()).body().mass_centre_velocity().norm());
+        const double hi = c_.refine_vorticity * U;
+        changed = f.regrid(fluid::blocks::max_of{near, fluid::blocks::leaf_indicator(f.tree(), f.vorticity_indicator(),
+                                                                                     hi, 0.25 * hi, levels_)},
+                           levels_);
+      } else {
+        changed = f.regrid(near, levels_);
+      }
       if (!changed && mesh_rows_ > 0) return;
       if (changed) ++regrids_;
       max_cells_ = std::max(max_cells_, long(s_.fluid().cell_count()));

@@ -179,6 +179,10 @@ parafsi_example_fails(example_drop_guide_bad_t_end drop_guide --t-end -1 --out $
 parafsi_example_dir_test(example_parachute_drop_tiny_pgs parachute_drop "history.csv|summary.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --pgs 4 --slice-times 0.01 --quiet)
+# The method's mixing-length closure (distance to the canopy and lines refreshed every step).
+parafsi_example_dir_test(example_parachute_drop_tiny_mixing_length parachute_drop "summary.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --turbulence mixing_length --quiet)
 # The block mesh (penalty coupling): the tiny scene for 20 ms, history, summary, a slice, VTK.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "history.csv|summary.csv|slice_00.010.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"
@@ -266,6 +270,10 @@ endforeach()
 parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
   --t-end inf)
 # The block mesh's limits, named.
+parafsi_example_refuses(example_parachute_drop_blocks_turbulence parachute_drop ""
+  "--mesh blocks runs no eddy-viscosity closure yet" --mesh blocks --turbulence smagorinsky)
+parafsi_example_refuses(example_parachute_drop_turbulence_inviscid parachute_drop ""
+  "cannot run with --viscosity inviscid" --turbulence mixing_length --viscosity inviscid)
 parafsi_example_refuses(example_parachute_drop_vorticity_tensor parachute_drop "" "--refine-vorticity needs --mesh blocks"
   --refine-vorticity 0.1)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"

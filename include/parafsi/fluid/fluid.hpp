@@ -32,3 +32,4 @@
 #include "viscosity/constant.hpp"
 #include "viscosity/inviscid.hpp"
 #include "viscosity/sutherland.hpp"
+#include "wall_distance.hpp"

@@ -262,6 +262,8 @@ class solver {
   }
   /// Distance to the nearest body per cell (mixing-length closure); +∞ by default.
   double* wall_distance() requires needs_wall_distance { return turb_store_.template get<field::wall_distance>(); }
+  /// The turbulence closure (its constants).
+  const Turbulence& turbulence() const noexcept { return turb_; }
 
   // ------------------------------------------------------------------ access
   index_t index(index_t i, index_t j, index_t k) const noexcept { return grid_.index(i, j, k); }

@@ -59,6 +59,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -99,9 +100,12 @@ struct drop_config {
   /// turning by that fraction across a cell; coarsened below a quarter of it); 0 = off
   double refine_vorticity = 0;
   std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
-  double t_end = 6.0;              ///< simulated time (s)
-  double history_every = 0.005;    ///< output interval (s)
-  double force_cutoff = 10.0;      ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
+  /// none | mixing_length (Prandtl's, l_m = min(κ d_w, C_l D0, Δ), d_w from the canopy and
+  /// line nodes) | smagorinsky (C_s = 0.1); a closure brings the air's viscosity with it
+  std::string turbulence = "none";
+  double t_end = 6.0;            ///< simulated time (s)
+  double history_every = 0.005;  ///< output interval (s)
+  double force_cutoff = 10.0;    ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
   double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
   double cfl = 0.9;   ///< CFL number of the fluid step
@@ -137,11 +141,17 @@ struct drop_config {
             coupling, "'");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
+    require(one_of(turbulence, {"none", "mixing_length", "smagorinsky"}),
+            "parachute_drop: turbulence must be none, mixing_length or smagorinsky, got '", turbulence, "'");
+    require(turbulence == "none" || viscosity != "inviscid", "parachute_drop: --turbulence ", turbulence,
+            " is an eddy viscosity added to the air's: it cannot run with --viscosity inviscid");
     require(one_of(packed, {"scene", "reduced_radius", "star_fold", "bundle", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
     if (mesh == "blocks") {
+      require(turbulence == "none", "parachute_drop: --mesh blocks runs no eddy-viscosity closure yet (--turbulence ",
+              turbulence, "); laminar --viscosity constant runs");
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
@@ -306,7 +316,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
   const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
-  su.viscous = !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
+  su.viscous = c.turbulence != "none" || !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
 }
 
@@ -323,6 +333,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("coupling", c.coupling).add("pgs_alpha", su.alpha).add("impedance", c.impedance);
   g.add("pfac", c.pfac).add("stiffening", c.stiffening).add("coupling_damping", c.coupling_damping);
   g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
+  if (c.turbulence != "none") g.add("turbulence", c.turbulence);
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
@@ -481,6 +492,7 @@ class drop_run {
         if (s_.steps() % c_.refine_every == 0) regrid();
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
+      update_wall_distance();
       s_.step(dt);
       if constexpr (block_mesh) {
         cell_steps_ += double(s_.fluid().cell_count());
@@ -630,6 +642,22 @@ class drop_run {
     }
   }
 
+  /// Mixing length: d_w from the structure's nodes (canopy and lines, box coordinates of
+  /// now) within reach C_l L_ref/κ, where κ d_w can be the closure's smallest length
+  /// (fluid/wall_distance.hpp); refreshed before every step.
+  void update_wall_distance() {
+    if constexpr (requires { s_.fluid().wall_distance(); }) {
+      auto& f = s_.fluid();
+      const auto& ml = f.turbulence();
+      const auto& nd = s_.structure().node_set();
+      const Eigen::Matrix3d Rt = f.pose().R.transpose();
+      wall_points_.resize(std::size_t(nd.size()));
+      for (index_t i = 0; i < nd.size(); ++i) wall_points_[std::size_t(i)] = Rt * (nd.position(i) - f.pose().X);
+      fluid::distance_to_points(f.grid(), wall_points_, ml.c_l * ml.ref_length / ml.kappa,
+                                std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())));
+    }
+  }
+
   /// Pressure of a corner cell of the box (the restart's check of the ambient).
   double corner_pressure() const {
     if constexpr (block_mesh) {
@@ -666,8 +694,9 @@ class drop_run {
                               -1, s_.time());
   }
 
-  int levels_ = 0;                          ///< block mesh: the finest level
-  std::optional<io::csv_writer> mesh_csv_;  ///< block mesh: mesh.csv
+  int levels_ = 0;                            ///< block mesh: the finest level
+  std::optional<io::csv_writer> mesh_csv_;    ///< block mesh: mesh.csv
+  std::vector<Eigen::Vector3d> wall_points_;  ///< mixing length: the structure's nodes in box coordinates
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
   double cell_steps_ = 0;  ///< Σ over steps of the leaf cells
   const drop_config& c_;
@@ -689,18 +718,29 @@ class drop_run {
 /// f(viscosity, frame) for the setup's choices (resolved once: everything below is
 /// compile-time).
 template <class F>
-drop_result with_fluid_policies(const drop_setup& su, F&& f) {
-  auto with_frame = [&](auto viscosity) -> drop_result {
-    if (su.fixed_box) return f(viscosity, frame::fixed{});
+drop_result with_fluid_policies(const drop_setup& su, const std::string& closure_name, F&& f) {
+  auto with_frame = [&](auto viscosity, auto closure) -> drop_result {
+    if (su.fixed_box) return f(viscosity, closure, frame::fixed{});
     frame::follow_payload follow;
     follow.axis = {0.0, 0.0, -1.0};  // box −z turns to the payload velocity
     follow.max_rate = 10.0;          // rad/s
-    return f(viscosity, follow);
+    return f(viscosity, closure, follow);
   };
-  if (!su.viscous) return with_frame(viscosity::inviscid{});
+  if (!su.viscous) return with_frame(viscosity::inviscid{}, turbulence::none{});
   viscosity::constant visc;
   visc.mu_value = su.params.air_viscosity;
-  return with_frame(visc);
+  if (closure_name == "mixing_length") {
+    turbulence::prandtl_mixing_length ml;
+    ml.ref_length = su.params.canopy.nominal_diameter;
+    ml.mu_cap = 1000.0 * su.params.air_viscosity;
+    return with_frame(visc, ml);
+  }
+  if (closure_name == "smagorinsky") {
+    turbulence::smagorinsky sm;
+    sm.mu_cap = 1000.0 * su.params.air_viscosity;
+    return with_frame(visc, sm);
+  }
+  return with_frame(visc, turbulence::none{});
 }
 
 }  // namespace detail
@@ -719,33 +759,35 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   const fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};
   auto bc = boundary::set::all(boundary::far_field{air.rho, air.u, air.p});
   bc.layer = {3, 0.5};
-  return detail::with_fluid_policies(su, [&](auto visc, auto frame) -> drop_result {
+  return detail::with_fluid_policies(su, c.turbulence, [&](auto visc, auto closure, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
     const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
-    if (c.mesh == "blocks") {
-      // The block mesh: one level to start with, refined to the canopy before the first step.
-      const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
-      fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,   flux::hllc_lm{},
-                             recon::muscl<limiter::van_leer>{},    visc, frame};
-      fl.fill_uniform(air);
-      place_drop_box(fl, su.box, chute);
-      if (parallel::max_threads() > 1) fl.set_threading(true);
-      if (c.coupling == "embedded") {
-        coupling::embedded_options eo;
-        eo.impedance = c.impedance;
-        using C = coupling::embedded<porosity::ergun>;
-        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
+    if constexpr (!decltype(closure)::active) {
+      if (c.mesh == "blocks") {
+        // The block mesh: one level to start with, refined to the canopy before the first step.
+        const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
+        fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,   flux::hllc_lm{},
+                               recon::muscl<limiter::van_leer>{},    visc, frame};
+        fl.fill_uniform(air);
+        place_drop_box(fl, su.box, chute);
+        if (parallel::max_threads() > 1) fl.set_threading(true);
+        if (c.coupling == "embedded") {
+          coupling::embedded_options eo;
+          eo.impedance = c.impedance;
+          using C = coupling::embedded<porosity::ergun>;
+          detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
+          return run.run(progress);
+        }
+        coupling::penalty_options po;
+        po.pfac = c.pfac;
+        po.stiffening = c.stiffening;
+        po.damping_ratio = c.coupling_damping;
+        using C = coupling::penalty<porosity::ergun>;
+        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
         return run.run(progress);
       }
-      coupling::penalty_options po;
-      po.pfac = c.pfac;
-      po.stiffening = c.stiffening;
-      po.damping_ratio = c.coupling_damping;
-      using C = coupling::penalty<porosity::ergun>;
-      detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
-      return run.run(progress);
     }
-    fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, frame};
+    fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, closure, frame};
     fl.initialize([&](const Eigen::Vector3d&) { return air; });
     place_drop_box(fl, su.box, chute);
     if (parallel::max_threads() > 1) fl.set_threading(true);

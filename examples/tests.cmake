@@ -197,6 +197,10 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks_embedded parachute_d
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_vorticity parachute_drop "summary.csv|mesh.csv"
   "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
   "1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --refine-vorticity 0.02 --quiet)
+# ... with the mixing-length closure (the wall distance on every block's cells and ghosts) ...
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_mixing_length parachute_drop "summary.csv|mesh.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
+  "1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --turbulence mixing_length --quiet)
 # ... and with the air's laminar viscosity.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_viscous parachute_drop "history.csv|summary.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
@@ -270,8 +274,6 @@ endforeach()
 parafsi_example_refuses(example_parachute_drop_inf_t_end parachute_drop "" "--t-end: value inf is not a finite number"
   --t-end inf)
 # The block mesh's limits, named.
-parafsi_example_refuses(example_parachute_drop_blocks_turbulence parachute_drop ""
-  "--mesh blocks runs no eddy-viscosity closure yet" --mesh blocks --turbulence smagorinsky)
 parafsi_example_refuses(example_parachute_drop_turbulence_inviscid parachute_drop ""
   "cannot run with --viscosity inviscid" --turbulence mixing_length --viscosity inviscid)
 parafsi_example_refuses(example_parachute_drop_vorticity_tensor parachute_drop "" "--refine-vorticity needs --mesh blocks"

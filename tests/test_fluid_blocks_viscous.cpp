@@ -5,10 +5,18 @@
 // momentum and energy are conserved to round-off, and a shear wave u_y = U sin(kx), whose
 // amplitude decays as exp(−ν k² t) (the transverse momentum diffuses; exact for the
 // linearised compressible equations), decays at that rate through a band one level finer.
+// Eddy viscosity (Smagorinsky; Prandtl's mixing length with a wall distance filled on each
+// block's cells and ghosts): one level reproduces the box solver; across levels and a regrid
+// (which carries μ_t over) mass, momentum and energy are conserved to round-off.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <numbers>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <parafsi/fluid/wall_distance.hpp>
 
 #include "fluid_test_util.hpp"
 
@@ -122,4 +130,99 @@ TEST_CASE("viscous block mesh across a level boundary: conservation to round-off
   CHECK(worst_m < 1e-13);
   CHECK(worst_p < 1e-12);
   CHECK(worst_e < 1e-13);
+}
+
+TEST_CASE("eddy viscosity on blocks: one level reproduces the box solver (Smagorinsky, mixing length)") {
+  const double pi2 = 2.0 * std::numbers::pi;
+  viscosity::constant mu;
+  mu.mu_value = 2e-4;
+  const auto bc = boundary::set::all(boundary::periodic{});
+  fluid::block_layout lay{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, 8};
+  auto field = [&](const Eigen::Vector3d& x) {
+    return fluid::prim<double>{rho0 * (1.0 + 0.1 * std::sin(pi2 * (x[0] + x[2]))),
+                               {0.05 * std::sin(pi2 * x[1]), 0.05 * std::sin(pi2 * x[2]), 0.05 * std::sin(pi2 * x[0])},
+                               p0 * (1.0 + 0.05 * std::cos(pi2 * x[1]))};
+  };
+  auto run = [&](auto closure, const char* label) {
+    fluid::block_solver blk{fb::tree({2, 2, 2}, {true, true, true}), lay, bc, mu, closure};
+    fluid::solver box{fluid::rectilinear_grid::uniform({16, 16, 16}, lay.lo, lay.hi), bc, mu, closure};
+    blk.initialize(field);
+    box.initialize(field);
+    if constexpr (requires { box.wall_distance(); }) {
+      // A plate of points in the middle of the box, > reach + 2 cells from its faces.
+      std::vector<Eigen::Vector3d> pts;
+      for (int a = 0; a <= 10; ++a)
+        for (int b = 0; b <= 10; ++b) pts.emplace_back(0.3 + 0.04 * a, 0.3 + 0.04 * b, 0.5 + 0.01 * a);
+      const double reach = closure.c_l * closure.ref_length / closure.kappa;
+      const auto& g = box.grid();
+      fluid::distance_to_points(g, pts, reach, std::span<double>(box.wall_distance(), std::size_t(g.total_cells())));
+      for (index_t id = 0; id < blk.block_count(); ++id) {
+        const auto& bg = blk.block_at(id).grid;
+        fluid::distance_to_points(bg, pts, reach,
+                                  std::span<double>(blk.wall_distance(id), std::size_t(bg.total_cells())), true);
+      }
+    }
+    double worst = 0, mut = 0;
+    for (int n = 0; n < 20; ++n) {
+      const double dt = box.stable_dt(0.5);
+      CHECK(blk.stable_dt(0.5) == doctest::Approx(dt).epsilon(1e-12));
+      box.step(dt);
+      blk.step(dt);
+      worst = std::max(worst, max_difference(blk, box));
+    }
+    const auto& g = box.grid();
+    for (index_t c = 0; c < g.total_cells(); ++c) mut = std::max(mut, box.eddy_viscosity()[c]);
+    MESSAGE(std::string(label), ": 20 steps, max relative state difference ", worst, "; largest mu_t ", mut,
+            " Pa s (mu ", mu.mu_value, ")");
+    CHECK(mut > 0.1 * mu.mu_value);  // the closure matters here
+    CHECK(worst < 1e-13);
+  };
+  turbulence::smagorinsky sm;
+  sm.cs = 0.17;
+  sm.mu_cap = 1.0;
+  run(sm, "Smagorinsky C_s 0.17");
+  turbulence::prandtl_mixing_length ml;
+  ml.ref_length = 1.0;
+  ml.mu_cap = 1.0;
+  run(ml, "mixing length, C_l D0 0.07 m");
+}
+
+TEST_CASE("eddy viscosity across levels and regrids: conservation to round-off, mu_t carried") {
+  const double pi2 = 2.0 * std::numbers::pi;
+  viscosity::constant mu;
+  mu.mu_value = 1e-3;
+  turbulence::smagorinsky sm;
+  sm.cs = 0.17;
+  sm.mu_cap = 1.0;
+  fluid::block_layout lay{{0, 0, 0}, {1, 0.25, 0.25}, {4, 1, 1}, 8};
+  fb::tree t({4, 1, 1}, {true, true, true});
+  t.refine_where(1, [](const fb::location& q) { return q.level == 0 && q.l[0] == 1; });
+  fluid::block_solver s{t, lay, boundary::set::all(boundary::periodic{}), mu, sm};
+  s.initialize([&](const Eigen::Vector3d& x) {
+    return fluid::prim<double>{rho0, {0.02 * std::sin(pi2 * x[2] * 4), 0.05 * std::sin(pi2 * x[0]), 0.0}, p0};
+  });
+  const auto t0 = s.totals();
+  double worst = 0;
+  int regrids = 0;
+  for (int n = 0; n < 40; ++n) {
+    s.step(s.stable_dt(0.5));
+    if (n == 19) {  // move the fine band one block along x
+      regrids += s.regrid([](const fb::location& q) { return q.l[0] == (q.level == 0 ? 2 : 4) || q.l[0] == 5 ? 1 : 0; },
+                          1);
+      double mx = 0;
+      for (index_t id = 0; id < s.block_count(); ++id) {
+        const auto& b = s.block_at(id);
+        for (index_t c = 0; c < b.grid.total_cells(); ++c) mx = std::max(mx, b.T.template get<fluid::field::mu_t>()[c]);
+      }
+      MESSAGE("after the regrid: largest mu_t carried over ", mx, " Pa s");
+      CHECK(mx > 0);
+    }
+    const auto t1 = s.totals();
+    worst = std::max({worst, std::fabs(t1.mass - t0.mass) / t0.mass, std::fabs(t1.energy - t0.energy) / t0.energy,
+                      std::fabs(t1.momentum[0] - t0.momentum[0]) / (0.05 * t0.mass),
+                      std::fabs(t1.momentum[1] - t0.momentum[1]) / (0.05 * t0.mass)});
+  }
+  MESSAGE(s.block_count(), " blocks, ", regrids, " regrid: worst relative change of mass, momentum, energy ", worst);
+  CHECK(regrids == 1);
+  CHECK(worst < 1e-13);
 }

@@ -19,9 +19,9 @@
 /// time policies are those of solver.hpp, and so are the optional per-cell sources (held
 /// constant over a step) and the far-field sponge: σ = s c_∞/L_s ((L − d)/L)³ with d the
 /// cell centre's distance from a far-field face in root-level cells less ½ and L_s = L
-/// root-level cells, which is the box solver's layer on a one-level mesh. Laminar viscosity
-/// and heat conduction (viscosity::constant …) run per block; eddy-viscosity closures are
-/// not on the block mesh yet (refused at compile time).
+/// root-level cells, which is the box solver's layer on a one-level mesh. Viscosity, heat
+/// conduction and eddy-viscosity closures run per block (μ_t and the mixing length's wall
+/// distance in mesh-wide fields; a block's wall distance covers its ghosts too).
 ///
 /// References: Berger M.J., Colella P. (1989) J. Comput. Phys. 82:64;
 ///   Stone J.M. et al. (2020) ApJS 249:4 (Athena++); Zhang W. et al. (2019) JOSS 4:1370 (AMReX).
@@ -83,11 +83,17 @@ class block_solver {
   using turbulence_type = Turbulence;
   using viscosity_type = Viscosity;
   static constexpr bool is_viscous = Viscosity::active || Turbulence::active;
-  static_assert(!Turbulence::active,
-                "fluid::block_solver: eddy-viscosity (turbulence) closures are not on the block mesh yet; laminar "
-                "viscosity is (fluid::solver has both)");
+  static constexpr bool has_eddy_viscosity = Turbulence::active;
+  static constexpr bool needs_wall_distance = [] {
+    if constexpr (Turbulence::active) return Turbulence::needs_wall_distance;
+    else return false;
+  }();
   /// Per-thread scratch of the viscous pass (one block at a time), none when inviscid.
   using viscous_storage = std::conditional_t<is_viscous, soa_of_t<viscous_fields>, empty_storage>;
+  /// Eddy viscosity (and the mixing length's wall distance) per cell, mesh-wide like U.
+  using turbulence_storage = std::conditional_t<
+      has_eddy_viscosity,
+      std::conditional_t<needs_wall_distance, soa<field::mu_t, field::wall_distance>, soa<field::mu_t>>, empty_storage>;
   static constexpr index_t ng = rectilinear_grid::ghosts;
   using cons_storage = soa_of_t<conserved_fields>;
   using prim_storage = soa_of_t<primitive_fields>;
@@ -117,6 +123,7 @@ class block_solver {
     slice<cons_storage> U, U0, dU;
     slice<prim_storage> W;
     slice<source_storage> sources;                   ///< per-cell sources (after enable_sources)
+    slice<turbulence_storage> T;                     ///< eddy viscosity (and wall distance), if a closure
     simd::aligned_vector<double> faces;              ///< face register: [axis][side][component][n²]
     std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
     std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
@@ -132,11 +139,13 @@ class block_solver {
         gas_(pick_value<kind::gas, gas::ideal>(policies...)),
         flux_(pick_value<kind::flux, Flux>(policies...)),
         recon_(pick_value<kind::reconstruction, Recon>(policies...)),
+        turb_(pick_value<kind::turbulence, Turbulence>(policies...)),
         visc_(pick_value<kind::viscosity, Viscosity>(policies...)),
         frame_(pick_value<kind::frame, Frame>(policies...)) {
     layout_.validate();
     gas_.validate();
     if constexpr (requires { visc_.validate(); }) visc_.validate();
+    if constexpr (requires { turb_.validate(); }) turb_.validate();
     bc_.validate();
     for (int d = 0; d < 3; ++d) {
       const bool plo = std::holds_alternative<boundary::periodic>(bc_.face[std::size_t(2 * d)]);
@@ -286,6 +295,17 @@ class block_solver {
     return blocks_[std::size_t(global / stride_)].grid.cell_volume(global % stride_);
   }
 
+  /// The turbulence closure (its constants).
+  const Turbulence& turbulence() const noexcept { return turb_; }
+  /// Wall distance d_w of block `id`'s cells, ghosts included (the mixing-length closure;
+  /// 1e30 = far until filled, e.g. by distance_to_points(block_at(id).grid, …, ghosts = true);
+  /// a regrid resets it).
+  double* wall_distance(index_t id) requires needs_wall_distance {
+    return blocks_[std::size_t(id)].T.template get<field::wall_distance>();
+  }
+  /// Eddy viscosity μ_t of the mesh (global_index; after the last stage).
+  const double* eddy_viscosity() const requires has_eddy_viscosity { return T_->template get<field::mu_t>(); }
+
   /// Sponge rate σ of a leaf cell (0 outside the layer).
   double sponge_rate(index_t id, index_t cell) const noexcept {
     const block& b = blocks_[std::size_t(id)];
@@ -308,8 +328,10 @@ class block_solver {
     rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
     detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
+      const double* mu_t = nullptr;
+      if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
       rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
-                                                                 visc_, turb_, nullptr, cfl, b.rate_slots, false);
+                                                                 visc_, turb_, mu_t, cfl, b.rate_slots, false);
     });
     double lam = 0.0;
     for (double r : rate_) lam = std::max(lam, r);
@@ -424,6 +446,7 @@ class block_solver {
     }
     ar.fields("conserved", *self.U_);
     if (sources) ar.fields("sources", *self.S_);
+    if constexpr (has_eddy_viscosity) ar.fields("turbulence", *self.T_);
   }
 
   /// Per leaf (tree order), max over its cells of |ω| h: the vorticity magnitude (central
@@ -496,11 +519,51 @@ class block_solver {
     fill_ghosts_all(t_);  // the old mesh's ghosts feed the prolongation slopes
     std::vector<block> old = std::move(blocks_);
     const std::unique_ptr<cons_storage> old_U = std::move(U_);  // the old blocks' slices point here
+    const std::unique_ptr<turbulence_storage> old_T = std::move(T_);
     blocks::tree old_tree = std::move(tree_);
     tree_ = std::move(next);
     build();
     transfer(old, old_tree);
+    if constexpr (has_eddy_viscosity) transfer_eddy_viscosity(old, old_tree);
     return true;
+  }
+
+  /// μ_t onto the new leaves (the first stable step after a regrid needs it): a cell takes the
+  /// value of the old cell holding its centre, a coarser cell the largest of the old cells it
+  /// covers (the stricter viscous step). The wall distance starts again at 1e30 (refill it).
+  void transfer_eddy_viscosity(const std::vector<block>& old, const blocks::tree& old_tree) {
+    const index_t n = n_;
+    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+      block& nb = blocks_[std::size_t(id)];
+      double* mu = nb.T.template get<field::mu_t>();
+      const blocks::location q = nb.where;
+      for (index_t kk = 0; kk < n; ++kk)
+        for (index_t j = 0; j < n; ++j)
+          for (index_t i = 0; i < n; ++i) {
+            const index_t G[3] = {q.l[0] * n + i, q.l[1] * n + j, q.l[2] * n + kk};
+            double m = 0;
+            // The old leaves over this cell's volume: its covering leaf, or its descendants.
+            auto visit = [&](auto&& self, const blocks::location& at, int level, const index_t* g) -> void {
+              const blocks::cover c = old_tree.find(at);
+              if (c.kind == blocks::cover::leaf) {
+                const block& ob = old[std::size_t(c.id)];
+                const int k = level - ob.where.level;  // ≥ 0: the old leaf is as coarse or coarser
+                index_t C[3];
+                for (int d = 0; d < 3; ++d) C[d] = (g[d] >> k) - ob.where.l[std::size_t(d)] * n;
+                m = std::max(m, ob.T.template get<field::mu_t>()[ob.grid.index(C[0], C[1], C[2])]);
+                return;
+              }
+              if (c.kind != blocks::cover::finer) return;
+              for (int o = 0; o < 8; ++o) {  // the cell's 8 children on the next level
+                const index_t h[3] = {2 * g[0] + (o & 1), 2 * g[1] + ((o >> 1) & 1), 2 * g[2] + ((o >> 2) & 1)};
+                const blocks::location child{level + 1, {h[0] / n, h[1] / n, h[2] / n}};
+                self(self, child, level + 1, h);
+              }
+            };
+            visit(visit, q, q.level, G);
+            mu[nb.grid.index(i, j, kk)] = m;
+          }
+    });
   }
 
  private:
@@ -518,6 +581,10 @@ class block_solver {
     dU_ = std::make_unique<cons_storage>(total, 0.0);
     W_ = std::make_unique<prim_storage>(total, 1.0);
     S_.reset();
+    if constexpr (has_eddy_viscosity) {
+      T_ = std::make_unique<turbulence_storage>(total, 0.0);
+      if constexpr (needs_wall_distance) std::fill_n(T_->template get<field::wall_distance>(), total, 1e30);
+    }
     for (std::size_t id = 0; id < nleaf; ++id) {
       block& b = blocks_[id];
       b.where = tree_.leaf(index_t(id));
@@ -541,6 +608,7 @@ class block_solver {
       b.U0 = {U0_.get(), off};
       b.dU = {dU_.get(), off};
       b.W = {W_.get(), off};
+      if constexpr (has_eddy_viscosity) b.T = {T_.get(), off};
       b.faces.assign(std::size_t(3 * 2 * 5 * n2), 0.0);
       b.bad_rows.assign(std::size_t(n2), 0);
       setup_sponge(b);
@@ -646,9 +714,14 @@ class block_solver {
           }
         }
     };
-    detail::viscous_pass<Viscosity, Turbulence, viscous_storage, empty_storage>{visc_, turb_,    gas_, b.grid,
-                                                                                vs,    no_turb_, false}(geo, W, dU,
-                                                                                                        keep);
+    if constexpr (has_eddy_viscosity)
+      detail::viscous_pass<Viscosity, Turbulence, viscous_storage, slice<turbulence_storage>>{visc_,  turb_, gas_,
+                                                                                              b.grid, vs,    b.T,
+                                                                                              false}(geo, W, dU, keep);
+    else
+      detail::viscous_pass<Viscosity, Turbulence, viscous_storage, empty_storage>{visc_, turb_,    gas_, b.grid,
+                                                                                  vs,    no_turb_, false}(geo, W, dU,
+                                                                                                          keep);
   }
 
   /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp, first-
@@ -893,7 +966,7 @@ class block_solver {
   gas::ideal gas_;
   Flux flux_;
   Recon recon_;
-  [[no_unique_address]] Turbulence turb_{};
+  [[no_unique_address]] Turbulence turb_;
   Viscosity visc_;
   Frame frame_;
   frame::pose pose_{};
@@ -904,7 +977,8 @@ class block_solver {
   index_t stride_ = 0;  ///< cells per block in the mesh-wide arrays
   std::unique_ptr<cons_storage> U_, U0_, dU_;
   std::unique_ptr<prim_storage> W_;
-  std::unique_ptr<source_storage> S_;  ///< null until enable_sources
+  std::unique_ptr<source_storage> S_;      ///< null until enable_sources
+  std::unique_ptr<turbulence_storage> T_;  ///< with an eddy-viscosity closure
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;

@@ -22,27 +22,30 @@
 
 namespace parafsi::fluid {
 
-/// d_w on every interior cell of `grid` (flat index, ghosts untouched) from `points` (box
-/// coordinates) within `reach` (m); `out` has grid.total_cells() entries.
+/// d_w on every interior cell of `grid` (flat index; with `ghosts`, on the ghost layers too,
+/// else they are left untouched) from `points` (box coordinates) within `reach` (m); `out`
+/// has grid.total_cells() entries. A block of a block mesh fills its ghosts as well, so the
+/// eddy viscosity of a ghost cell is its neighbour's.
 inline void distance_to_points(const rectilinear_grid& grid, std::span<const Eigen::Vector3d> points, double reach,
-                               std::span<double> out) {
+                               std::span<double> out, bool ghosts = false) {
   require(std::isfinite(reach) && reach > 0, "fluid::distance_to_points: reach must be finite and > 0, got ", reach);
   require(out.size() == std::size_t(grid.total_cells()), "fluid::distance_to_points: ", out.size(),
           " values for a grid of ", grid.total_cells(), " cells (ghosts included)");
   constexpr double far = 1e30;
-  for (index_t k = 0; k < grid.n(2); ++k)
-    for (index_t j = 0; j < grid.n(1); ++j) {
-      double* row = out.data() + grid.index(0, j, k);
-      std::fill(row, row + grid.n(0), far);
+  const index_t g = ghosts ? rectilinear_grid::ghosts : 0;  // cells −g … n − 1 + g
+  for (index_t k = -g; k < grid.n(2) + g; ++k)
+    for (index_t j = -g; j < grid.n(1) + g; ++j) {
+      double* row = out.data() + grid.index(-g, j, k);
+      std::fill(row, row + grid.n(0) + 2 * g, far);
     }
   for (const Eigen::Vector3d& p : points) {
     require(p.allFinite(), "fluid::distance_to_points: a point is not finite");
     index_t lo[3], hi[3];
     for (int d = 0; d < 3; ++d) {
-      const double* c = grid.centres(d);
-      const index_t n = grid.n(d);
-      lo[d] = index_t(std::lower_bound(c, c + n, p[d] - reach) - c);
-      hi[d] = index_t(std::upper_bound(c, c + n, p[d] + reach) - c);
+      const double* c = grid.centres(d) - g;
+      const index_t n = grid.n(d) + 2 * g;
+      lo[d] = index_t(std::lower_bound(c, c + n, p[d] - reach) - c) - g;
+      hi[d] = index_t(std::upper_bound(c, c + n, p[d] + reach) - c) - g;
     }
     const double r2 = reach * reach;
     for (index_t k = lo[2]; k < hi[2]; ++k) {

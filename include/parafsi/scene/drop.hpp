@@ -150,8 +150,6 @@ struct drop_config {
     require(box == "follow" || box == "fixed", "parachute_drop: box must be follow or fixed, got '", box, "'");
     require(mesh == "tensor" || mesh == "blocks", "parachute_drop: mesh must be tensor or blocks, got '", mesh, "'");
     if (mesh == "blocks") {
-      require(turbulence == "none", "parachute_drop: --mesh blocks runs no eddy-viscosity closure yet (--turbulence ",
-              turbulence, "); laminar --viscosity constant runs");
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
@@ -646,15 +644,25 @@ class drop_run {
   /// now) within reach C_l L_ref/κ, where κ d_w can be the closure's smallest length
   /// (fluid/wall_distance.hpp); refreshed before every step.
   void update_wall_distance() {
-    if constexpr (requires { s_.fluid().wall_distance(); }) {
+    if constexpr (Fluid::needs_wall_distance) {
       auto& f = s_.fluid();
       const auto& ml = f.turbulence();
       const auto& nd = s_.structure().node_set();
       const Eigen::Matrix3d Rt = f.pose().R.transpose();
       wall_points_.resize(std::size_t(nd.size()));
       for (index_t i = 0; i < nd.size(); ++i) wall_points_[std::size_t(i)] = Rt * (nd.position(i) - f.pose().X);
-      fluid::distance_to_points(f.grid(), wall_points_, ml.c_l * ml.ref_length / ml.kappa,
-                                std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())));
+      const double reach = ml.c_l * ml.ref_length / ml.kappa;
+      if constexpr (block_mesh) {
+        // Each block's cells and ghosts (a ghost's eddy viscosity is then its neighbour's).
+        parallel::for_range(0, f.block_count(), [&](index_t id) {
+          const auto& g = f.block_at(id).grid;
+          fluid::distance_to_points(g, wall_points_, reach,
+                                    std::span<double>(f.wall_distance(id), std::size_t(g.total_cells())), true);
+        });
+      } else {
+        fluid::distance_to_points(f.grid(), wall_points_, reach,
+                                  std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())));
+      }
     }
   }
 
@@ -762,30 +770,28 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   return detail::with_fluid_policies(su, c.turbulence, [&](auto visc, auto closure, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
     const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
-    if constexpr (!decltype(closure)::active) {
-      if (c.mesh == "blocks") {
-        // The block mesh: one level to start with, refined to the canopy before the first step.
-        const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
-        fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,   flux::hllc_lm{},
-                               recon::muscl<limiter::van_leer>{},    visc, frame};
-        fl.fill_uniform(air);
-        place_drop_box(fl, su.box, chute);
-        if (parallel::max_threads() > 1) fl.set_threading(true);
-        if (c.coupling == "embedded") {
-          coupling::embedded_options eo;
-          eo.impedance = c.impedance;
-          using C = coupling::embedded<porosity::ergun>;
-          detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
-          return run.run(progress);
-        }
-        coupling::penalty_options po;
-        po.pfac = c.pfac;
-        po.stiffening = c.stiffening;
-        po.damping_ratio = c.coupling_damping;
-        using C = coupling::penalty<porosity::ergun>;
-        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
+    if (c.mesh == "blocks") {
+      // The block mesh: one level to start with, refined to the canopy before the first step.
+      const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
+      fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,      flux::hllc_lm{},
+                             recon::muscl<limiter::van_leer>{},    visc, closure, frame};
+      fl.fill_uniform(air);
+      place_drop_box(fl, su.box, chute);
+      if (parallel::max_threads() > 1) fl.set_threading(true);
+      if (c.coupling == "embedded") {
+        coupling::embedded_options eo;
+        eo.impedance = c.impedance;
+        using C = coupling::embedded<porosity::ergun>;
+        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
         return run.run(progress);
       }
+      coupling::penalty_options po;
+      po.pfac = c.pfac;
+      po.stiffening = c.stiffening;
+      po.damping_ratio = c.coupling_damping;
+      using C = coupling::penalty<porosity::ergun>;
+      detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, po}, levels};
+      return run.run(progress);
     }
     fluid::solver fl{grid, bc, flux::hllc_lm{}, recon::muscl<limiter::van_leer>{}, visc, closure, frame};
     fl.initialize([&](const Eigen::Vector3d&) { return air; });

@@ -515,8 +515,8 @@ class block_solver {
       detail::par_for(threaded_, 0, nb, [&](index_t id) {
         block& b = blocks_[std::size_t(id)];
         auto& bufs = bufs_[std::size_t(parallel::thread_id())];
-        detail::compute_primitives(b.grid.total_cells(), gas_, detail::conserved_ptrs(std::as_const(b.U)),
-                                   detail::primitive_ptrs(b.W), false);
+        detail::compute_primitives_sweeps(b.grid, gas_, detail::conserved_ptrs(std::as_const(b.U)),
+                                          detail::primitive_ptrs(b.W));
         const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
                                                   detail::primitive_ptrs(std::as_const(b.W))};
         const auto dU = detail::conserved_ptrs(b.dU);

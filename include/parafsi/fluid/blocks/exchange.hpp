@@ -1,7 +1,10 @@
 /// \file exchange.hpp
 /// Ghost cells of the blocks of a block mesh from their neighbours, as a plan built once
-/// per mesh (tree) and executed every stage. A ghost cell of a block of level L whose
-/// centre lies in the box is covered by exactly one of
+/// per mesh (tree) and executed every stage. The plan fills the ghost slabs of the six
+/// faces (ghost along one axis, interior along the other two), which is all that the flux
+/// sweeps and the regrid's prolongation slopes read (one axis at a time); the edge and
+/// corner ghosts (outside along two or three axes) are left as they are. A face ghost
+/// cell of a block of level L whose centre lies in the box is covered by exactly one of
 ///   - a leaf of level L: copied;
 ///   - leaves of level L + 1: the volume mean of the 8 fine cells it holds (restriction);
 ///   - a leaf of level L − 1: the coarse cell's conserved state plus limited slopes
@@ -17,7 +20,7 @@
 /// parallel; ghost cells outside the box are left to the boundary conditions, applied
 /// afterwards (detail/ghosts.hpp with the block's boundary faces). On periodic axes the
 /// neighbour search wraps. The 2:1 balance of the tree (tree.hpp) guarantees one level of
-/// difference across every ghost layer; the plan checks it.
+/// difference across every ghost layer; the plan checks it across faces.
 ///
 /// The children's mean of a prolonged coarse cell equals it (the offsets cancel), so the
 /// same operator is conservative when a regrid splits a block.
@@ -169,7 +172,8 @@ inline std::vector<block_plan> build_plan(const tree& t, index_t n) {
     for (index_t k = -g; k < n + g; ++k)
       for (index_t j = -g; j < n + g; ++j)
         for (index_t i = -g; i < n + g; ++i) {
-          if (i >= 0 && i < n && j >= 0 && j < n && k >= 0 && k < n) continue;
+          const int outside = int(i < 0 || i >= n) + int(j < 0 || j >= n) + int(k < 0 || k >= n);
+          if (outside != 1) continue;  // interior, or an edge or corner ghost
           std::array<std::int64_t, 3> G{q.l[0] * n + i, q.l[1] * n + j, q.l[2] * n + k};
           if (!wrap_cell(G, L)) continue;  // outside the box: boundary condition
           const index_t dst = at(i, j, k);

@@ -23,6 +23,7 @@
 /// References: Berger M.J., Colella P. (1989) J. Comput. Phys. 82:64;
 ///   Stone J.M. et al. (2020) ApJS 249:4 (Athena++); Zhang W. et al. (2019) JOSS 4:1370 (AMReX).
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -314,7 +315,7 @@ class block_solver {
   void step(double dt, const frame::motion& m) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
     pose_.set_motion(m);
-    copy_state(*U0_, *U_);
+    save_stage_start();
     double pose_time = 0.0;
     for (int s = 0; s < Time::stages; ++s) {
       const double c = Time::c[std::size_t(s)];
@@ -487,12 +488,19 @@ class block_solver {
     return r;
   }
 
-  void copy_state(cons_storage& dst, const cons_storage& src) const {
-    for (std::size_t f = 0; f < cons_storage::field_count; ++f) {
-      double* d = dst.data(f);
-      const double* s = src.data(f);
-      for (index_t c = 0; c < src.size(); ++c) d[c] = s[c];
-    }
+  /// U⁰ ← U on the interior cells of every block (the update reads no others).
+  void save_stage_start() {
+    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+      block& b = blocks_[std::size_t(id)];
+      const auto U = detail::conserved_ptrs(std::as_const(b.U));
+      const auto U0 = detail::conserved_ptrs(b.U0);
+      for (int f = 0; f < 5; ++f)
+        for (index_t k = 0; k < n_; ++k)
+          for (index_t j = 0; j < n_; ++j) {
+            const index_t c = b.grid.index(0, j, k);
+            std::copy_n(U[f] + c, n_, U0[f] + c);
+          }
+    });
   }
   void validate_state(const prim<double>& w, const char* where) const {
     require(std::isfinite(w.rho) && w.rho > 0.0, "fluid::block_solver::", where, ": density must be > 0, got ", w.rho);
@@ -530,7 +538,8 @@ class block_solver {
       timed(times_.sources, [&] { detail::par_for(threaded_, 0, nb, [&](index_t id) { add_sources(id); }); });
   }
 
-  /// Every block's ghosts: from neighbours, then the box's boundary conditions.
+  /// Every block's face ghosts (not edges and corners, which nothing reads): from
+  /// neighbours, then the box's boundary conditions.
   void fill_ghosts_all(double t) {
     const auto geo = detail::geometry(pose_);
     const index_t nb = block_count();
@@ -539,7 +548,7 @@ class block_solver {
     detail::par_for(threaded_, 0, nb, [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       if (b.boundary != std::array<bool, 6>{})
-        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary);
+        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, false);
     });
   }
 

@@ -488,18 +488,17 @@ class block_solver {
     return r;
   }
 
-  /// U⁰ ← U on the interior cells of every block (the update reads no others).
+  /// U⁰ ← U on every block's span from its first to its last interior cell (the update
+  /// reads the interior cells only).
   void save_stage_start() {
+    const index_t first = blocks::block_index{n_}(0, 0, 0);
+    const index_t count = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1 - first;
     detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       const auto U = detail::conserved_ptrs(std::as_const(b.U));
       const auto U0 = detail::conserved_ptrs(b.U0);
       for (int f = 0; f < 5; ++f)
-        for (index_t k = 0; k < n_; ++k)
-          for (index_t j = 0; j < n_; ++j) {
-            const index_t c = b.grid.index(0, j, k);
-            std::copy_n(U[f] + c, n_, U0[f] + c);
-          }
+        for (index_t c = first; c < first + count; ++c) U0[f][c] = U[f][c];
     });
   }
   void validate_state(const prim<double>& w, const char* where) const {

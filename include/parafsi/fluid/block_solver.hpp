@@ -6,9 +6,9 @@
 /// one-level block mesh gives the box solver's answer to round-off. One time step for all
 /// levels (the membranes sit on the finest level, which sets the step anyway); every
 /// Runge–Kutta stage is the recipe
-///   exchange ghosts (copy · restrict · prolong, blocks/exchange.hpp) → boundary ghosts →
-///   primitives → three flux sweeps per block, keeping boundary-face fluxes →
-///   coarse–fine flux correction (blocks/flux_correction.hpp) → update,
+///   exchange face ghosts (copy · restrict · prolong, blocks/exchange.hpp) → boundary
+///   ghosts → primitives where the sweeps read them → three flux sweeps per block, keeping
+///   boundary-face fluxes → coarse–fine flux correction (blocks/flux_correction.hpp) → update,
 /// which conserves mass, momentum and energy to round-off across levels. Blocks run in
 /// parallel (OpenMP) with serial kernels inside, so results do not depend on the thread
 /// count.

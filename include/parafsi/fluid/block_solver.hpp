@@ -6,11 +6,12 @@
 /// one-level block mesh gives the box solver's answer to round-off. One time step for all
 /// levels (the membranes sit on the finest level, which sets the step anyway); every
 /// Runge–Kutta stage is the recipe
-///   exchange ghosts (copy · restrict · prolong, blocks/exchange.hpp) → boundary ghosts →
-///   primitives → three flux sweeps per block, keeping boundary-face fluxes → viscous
-///   pass (with a viscosity policy; its boundary-face fluxes join the kept ones) →
-///   coarse–fine flux correction (blocks/flux_correction.hpp) → the coupling's face
-///   patches → sources and sponge → update,
+///   exchange face ghosts (copy · restrict · prolong, blocks/exchange.hpp; with a viscosity
+///   policy edges and corners too) → boundary ghosts → primitives where the kernels read
+///   them → three flux sweeps per block, keeping boundary-face fluxes → viscous pass (with
+///   a viscosity policy; its boundary-face fluxes join the kept ones) → coarse–fine flux
+///   correction (blocks/flux_correction.hpp) → the coupling's face patches → sources and
+///   sponge → update,
 /// which conserves mass, momentum and energy to round-off across levels. Blocks run in
 /// parallel (OpenMP) with serial kernels inside, so results do not depend on the thread
 /// count.
@@ -26,6 +27,7 @@
 /// References: Berger M.J., Colella P. (1989) J. Comput. Phys. 82:64;
 ///   Stone J.M. et al. (2020) ApJS 249:4 (Athena++); Zhang W. et al. (2019) JOSS 4:1370 (AMReX).
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -352,7 +354,7 @@ class block_solver {
   void step(double dt, const frame::motion& m, Patcher& patcher) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
     pose_.set_motion(m);
-    copy_state(*U0_, *U_);
+    save_stage_start();
     double pose_time = 0.0;
     for (int s = 0; s < Time::stages; ++s) {
       const double c = Time::c[std::size_t(s)];
@@ -614,7 +616,7 @@ class block_solver {
       setup_sponge(b);
     }
     if (sources_on_) allocate_sources();
-    plan_ = blocks::build_plan(tree_, n_);
+    plan_ = blocks::build_plan(tree_, n_, /*edges=*/is_viscous);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
     U_all_.resize(nleaf);
     for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
@@ -637,12 +639,18 @@ class block_solver {
     return r;
   }
 
-  void copy_state(cons_storage& dst, const cons_storage& src) const {
-    for (std::size_t f = 0; f < cons_storage::field_count; ++f) {
-      double* d = dst.data(f);
-      const double* s = src.data(f);
-      for (index_t c = 0; c < src.size(); ++c) d[c] = s[c];
-    }
+  /// U⁰ ← U on every block's span from its first to its last interior cell (the update
+  /// reads the interior cells only).
+  void save_stage_start() {
+    const index_t first = blocks::block_index{n_}(0, 0, 0);
+    const index_t count = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1 - first;
+    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+      block& b = blocks_[std::size_t(id)];
+      const auto U = detail::conserved_ptrs(std::as_const(b.U));
+      const auto U0 = detail::conserved_ptrs(b.U0);
+      for (int f = 0; f < 5; ++f)
+        for (index_t c = first; c < first + count; ++c) U0[f][c] = U[f][c];
+    });
   }
   void validate_state(const prim<double>& w, const char* where) const {
     require(std::isfinite(w.rho) && w.rho > 0.0, "fluid::block_solver::", where, ": density must be > 0, got ", w.rho);
@@ -672,8 +680,12 @@ class block_solver {
       detail::par_for(threaded_, 0, nb, [&](index_t id) {
         block& b = blocks_[std::size_t(id)];
         auto& bufs = bufs_[std::size_t(parallel::thread_id())];
-        detail::compute_primitives(b.grid.total_cells(), gas_, detail::conserved_ptrs(std::as_const(b.U)),
-                                   detail::primitive_ptrs(b.W), false);
+        if constexpr (is_viscous)  // the viscous pass reads the whole ghost ring
+          detail::compute_primitives(b.grid.total_cells(), gas_, detail::conserved_ptrs(std::as_const(b.U)),
+                                     detail::primitive_ptrs(b.W), false);
+        else
+          detail::compute_primitives_sweeps(b.grid, gas_, detail::conserved_ptrs(std::as_const(b.U)),
+                                            detail::primitive_ptrs(b.W));
         const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
                                                   detail::primitive_ptrs(std::as_const(b.W))};
         const auto dU = detail::conserved_ptrs(b.dU);
@@ -790,7 +802,9 @@ class block_solver {
     }
   }
 
-  /// Every block's ghosts: from neighbours, then the box's boundary conditions.
+  /// Every block's face ghosts from neighbours, then the box's boundary conditions; edge
+  /// and corner ghosts only for the viscous pass (its cell gradients on the ghost ring read
+  /// them), which the inviscid kernels never read.
   void fill_ghosts_all(double t) {
     const auto geo = detail::geometry(pose_);
     const index_t nb = block_count();
@@ -799,7 +813,7 @@ class block_solver {
     detail::par_for(threaded_, 0, nb, [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       if (b.boundary != std::array<bool, 6>{})
-        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary);
+        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous);
     });
   }
 

@@ -1,7 +1,10 @@
 /// \file exchange.hpp
 /// Ghost cells of the blocks of a block mesh from their neighbours, as a plan built once
-/// per mesh (tree) and executed every stage. A ghost cell of a block of level L whose
-/// centre lies in the box is covered by exactly one of
+/// per mesh (tree) and executed every stage. The plan fills the ghost slabs of the six
+/// faces (ghost along one axis, interior along the other two), which is all that the flux
+/// sweeps and the regrid's prolongation slopes read (one axis at a time); the edge and
+/// corner ghosts (outside along two or three axes) are left as they are. A face ghost
+/// cell of a block of level L whose centre lies in the box is covered by exactly one of
 ///   - a leaf of level L: copied;
 ///   - leaves of level L + 1: the volume mean of the 8 fine cells it holds (restriction);
 ///   - a leaf of level L − 1: the coarse cell's conserved state plus limited slopes
@@ -10,11 +13,14 @@
 ///     outside the box or on a coarser level counts as a zero one-sided difference; a
 ///     stencil cell covered by finer cells is their mean. If the result is not a gas
 ///     (ρ ≤ 0 or p ≤ 0) the ghost takes U_c.
+/// Copies run as boxes of cells (block_plan::copy_box): the per-cell items merged where
+/// destination and source are both contiguous, along x, then y, then z (a face slab of
+/// n × n × 2 cells is one box), so the exchange is a few contiguous loops per field.
 /// Every item reads interior cells only, so the blocks can be filled in any order and in
 /// parallel; ghost cells outside the box are left to the boundary conditions, applied
 /// afterwards (detail/ghosts.hpp with the block's boundary faces). On periodic axes the
 /// neighbour search wraps. The 2:1 balance of the tree (tree.hpp) guarantees one level of
-/// difference across every ghost layer; the plan checks it.
+/// difference across every ghost layer; the plan checks it across faces.
 ///
 /// The children's mean of a prolonged coarse cell equals it (the offsets cancel), so the
 /// same operator is conservative when a regrid splits a block.
@@ -53,7 +59,13 @@ struct block_plan {
     std::array<value_ref, 6> side;  ///< −x, +x, −y, +y, −z, +z neighbours of the coarse cell
     std::array<double, 3> offset;   ///< δ_d = ±¼
   };
-  std::vector<copy_item> copies;
+  /// Cells dst + a + b s_y + c s_z ← src + a + b s_y + c s_z (a < extent[0], b < extent[1],
+  /// c < extent[2]; s_y, s_z the strides of a block) from a leaf of the same level.
+  struct copy_box {
+    index_t dst, src_block, src;
+    std::array<index_t, 3> extent;
+  };
+  std::vector<copy_box> copies;
   std::vector<copy_item> restrictions;  ///< src: the lowest fine cell of the 2×2×2 group
   std::vector<prolong_item> prolongations;
 };
@@ -74,8 +86,50 @@ struct block_index {
   }
 };
 
+/// Merge per-cell copy items (in increasing dst order) into boxes: runs of consecutive
+/// cells first, then runs of equal length stacked along y (stride sy) into planes, then
+/// planes stacked along z (stride sz). Each box copies exactly the cells of its items.
+inline std::vector<block_plan::copy_box> merge_copies(const std::vector<block_plan::copy_item>& items, index_t sy,
+                                                      index_t sz) {
+  using box = block_plan::copy_box;
+  std::vector<box> runs;
+  for (const auto& it : items) {
+    if (!runs.empty()) {
+      box& r = runs.back();
+      if (r.src_block == it.src_block && r.dst + r.extent[0] == it.dst && r.src + r.extent[0] == it.src) {
+        ++r.extent[0];
+        continue;
+      }
+    }
+    runs.push_back({it.dst, it.src_block, it.src, {1, 1, 1}});
+  }
+  // Stack boxes along axis d (stride st): a box extends the first earlier box it continues.
+  auto stack = [](const std::vector<box>& in, int d, index_t st) {
+    std::vector<box> out;
+    for (const auto& b : in) {
+      bool merged = false;
+      for (auto& o : out) {
+        const index_t step = o.extent[std::size_t(d)] * st;
+        bool same = o.src_block == b.src_block && o.dst + step == b.dst && o.src + step == b.src;
+        for (int e = 0; e < 3; ++e)
+          if (e != d) same = same && o.extent[std::size_t(e)] == b.extent[std::size_t(e)];
+        if (same) {
+          o.extent[std::size_t(d)] += b.extent[std::size_t(d)];
+          merged = true;
+          break;
+        }
+      }
+      if (!merged) out.push_back(b);
+    }
+    return out;
+  };
+  return stack(stack(runs, 1, sy), 2, sz);
+}
+
 /// Build every block's plan for the leaves of `t` with n cells per block edge.
-inline std::vector<block_plan> build_plan(const tree& t, index_t n) {
+/// With `edges`, the edge and corner ghosts too (what a viscous pass's cell gradients on
+/// the ghost ring read); the tree's balance across edges and corners covers them.
+inline std::vector<block_plan> build_plan(const tree& t, index_t n, bool edges = false) {
   check_block_size(n);
   constexpr index_t g = rectilinear_grid::ghosts;
   const block_index at{n};
@@ -111,20 +165,23 @@ inline std::vector<block_plan> build_plan(const tree& t, index_t n) {
   };
 
   std::vector<block_plan> plans(std::size_t(t.size()));
+  std::vector<block_plan::copy_item> copies;
   for (index_t b = 0; b < t.size(); ++b) {
     const location q = t.leaf(b);
     const int L = q.level;
     block_plan& p = plans[std::size_t(b)];
+    copies.clear();
     for (index_t k = -g; k < n + g; ++k)
       for (index_t j = -g; j < n + g; ++j)
         for (index_t i = -g; i < n + g; ++i) {
-          if (i >= 0 && i < n && j >= 0 && j < n && k >= 0 && k < n) continue;
+          const int outside = int(i < 0 || i >= n) + int(j < 0 || j >= n) + int(k < 0 || k >= n);
+          if (outside == 0 || (outside > 1 && !edges)) continue;  // interior, or an edge or corner ghost
           std::array<std::int64_t, 3> G{q.l[0] * n + i, q.l[1] * n + j, q.l[2] * n + k};
           if (!wrap_cell(G, L)) continue;  // outside the box: boundary condition
           const index_t dst = at(i, j, k);
           const cover c = t.find(block_of(G, L));
           if (c.kind == cover::leaf && c.level == L) {
-            p.copies.push_back({dst, c.id, local(G, t.leaf(c.id))});
+            copies.push_back({dst, c.id, local(G, t.leaf(c.id))});
           } else if (c.kind == cover::finer) {
             const std::array<std::int64_t, 3> F{2 * G[0], 2 * G[1], 2 * G[2]};
             const cover f = t.find(block_of(F, L + 1));
@@ -153,6 +210,7 @@ inline std::vector<block_plan> build_plan(const tree& t, index_t n) {
             p.prolongations.push_back(it);
           }
         }
+    p.copies = merge_copies(copies, n + 2 * g, (n + 2 * g) * (n + 2 * g));
   }
   return plans;
 }
@@ -170,9 +228,18 @@ inline void execute_plan(const block_plan& p, index_t b, const block_fields& U, 
   constexpr index_t g = rectilinear_grid::ghosts;
   const index_t sy = n + 2 * g, sz = sy * sy;
   const auto& dst = U[std::size_t(b)];
-  for (const auto& it : p.copies) {
-    const auto& src = U[std::size_t(it.src_block)];
-    for (int f = 0; f < 5; ++f) dst[f][it.dst] = src[f][it.src];
+  for (const auto& bx : p.copies) {
+    const auto& src = U[std::size_t(bx.src_block)];
+    const index_t ex = bx.extent[0], ey = bx.extent[1], ez = bx.extent[2];
+    for (int f = 0; f < 5; ++f) {
+      double* d = dst[f] + bx.dst;
+      const double* s = src[f] + bx.src;
+      for (index_t c = 0; c < ez; ++c)
+        for (index_t r = 0; r < ey; ++r) {
+          const index_t o = r * sy + c * sz;
+          for (index_t a = 0; a < ex; ++a) d[o + a] = s[o + a];
+        }
+    }
   }
   for (const auto& it : p.restrictions) {
     const auto& src = U[std::size_t(it.src_block)];

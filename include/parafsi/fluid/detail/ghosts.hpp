@@ -4,9 +4,9 @@
 /// over all (i, j), so edges and corners get filled. Periodic faces copy the opposite
 /// interior layers; the others get cond.ghost(W_mirror, W_adjacent, n_out, w_n, gas, t)
 /// with w_n the grid's outward normal speed at the boundary face centre.
-/// On a block mesh a block fills only its faces on the box boundary (`fill`); the
-/// ghosts of its other faces come from neighbouring blocks first, so the transverse
-/// ranges then include those ghosts (edges and corners get the boundary's image of them).
+/// On a block mesh a block fills only its faces on the box boundary (`fill`), and only
+/// their face slabs (`edges` false: interior transverse ranges; the blocks' exchange,
+/// blocks/exchange.hpp, leaves edge and corner ghosts too, as no block kernel reads them).
 #pragma once
 #include <array>
 #include <type_traits>
@@ -24,7 +24,7 @@ inline constexpr std::array<bool, 6> all_faces{true, true, true, true, true, tru
 
 inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
                         const stage_geometry& geo, double t, const fields5<double>& U, bool threaded,
-                        const std::array<bool, 6>& fill = all_faces) {
+                        const std::array<bool, 6>& fill = all_faces, bool edges = true) {
   constexpr index_t ng = rectilinear_grid::ghosts;
   const index_t n[3] = {grid.n(0), grid.n(1), grid.n(2)};
   for (int d = 0; d < 3; ++d) {
@@ -32,7 +32,8 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
     // Ranges of the two transverse axes: include the ghosts already filled (axes done
     // before this one, and faces filled from neighbouring blocks).
     auto range = [&](int axis) -> std::pair<index_t, index_t> {
-      const bool lo = axis < d || !fill[std::size_t(2 * axis)], hi = axis < d || !fill[std::size_t(2 * axis + 1)];
+      const bool lo = edges && (axis < d || !fill[std::size_t(2 * axis)]),
+                 hi = edges && (axis < d || !fill[std::size_t(2 * axis + 1)]);
       return {lo ? -ng : 0, hi ? n[axis] + ng : n[axis]};
     };
     const auto ra = range(a), rb = range(b);

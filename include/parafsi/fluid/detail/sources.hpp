@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <variant>
 
+#include "../../core/simd.hpp"
 #include "../boundary/condition.hpp"
 #include "../gas.hpp"
 #include "../grid.hpp"
@@ -61,8 +62,8 @@ inline cons<double> setup_sponge(const rectilinear_grid& grid, const boundary::s
   return sponge_target(bcs, gas, fallback);
 }
 
-/// dU += S (Sources) and dU −= σ (U − U_∞) (Sponge) on interior cells. `src` in the
-/// order (ρ, mx, my, mz, E).
+/// dU += S (Sources), then dU −= σ (U − U_∞) where σ > 0 (Sponge), on interior cells,
+/// packed along x rows. `src` in the order (ρ, mx, my, mz, E).
 template <bool Sources, bool Sponge>
 void add_sources(const rectilinear_grid& grid, const fields5<double>& dU, const fields5<const double>& U,
                  const fields5<const double>& src, const double* sig, const cons<double>& target, bool threaded) {
@@ -70,16 +71,21 @@ void add_sources(const rectilinear_grid& grid, const fields5<double>& dU, const 
   const double tgt[5] = {target.rho, target.m.x, target.m.y, target.m.z, target.E};
   par_for(threaded, 0, ny * nz, [&](index_t r) {
     const index_t base = grid.index(0, r % ny, r / ny);
-    for (index_t i = 0; i < nx; ++i) {
+    simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
+      using V = typename decltype(tag)::type;
       const index_t c = base + i;
+      V q[5];
+      for (int f = 0; f < 5; ++f) q[f] = simd::load<V>(dU[f] + c);
       if constexpr (Sources)
-        for (int f = 0; f < 5; ++f) dU[f][c] += src[f][c];
+        for (int f = 0; f < 5; ++f) q[f] = q[f] + simd::load<V>(src[f] + c);
       if constexpr (Sponge) {
-        const double s = sig[c];
-        if (s > 0.0)
-          for (int f = 0; f < 5; ++f) dU[f][c] -= s * (U[f][c] - tgt[f]);
+        const V s = simd::load<V>(sig + c);
+        const auto on = s > V(0.0);
+        if (simd::any(on))
+          for (int f = 0; f < 5; ++f) q[f] = simd::select(on, q[f] - s * (simd::load<V>(U[f] + c) - V(tgt[f])), q[f]);
       }
-    }
+      for (int f = 0; f < 5; ++f) simd::store(dU[f] + c, q[f]);
+    });
   });
 }
 

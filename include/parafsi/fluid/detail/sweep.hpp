@@ -201,7 +201,10 @@ void sweep(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const 
             if (row == 0 || row == nD) {
               const fields5<double>& side = row == 0 ? reg.lo : reg.hi;
               for (int f = 0; f < 5; ++f)
-                for (index_t i = 0; i < nx; ++i) side[f][i + nx * q] = cur[f][i];
+                simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
+                  using V = typename decltype(tag)::type;
+                  simd::store(side[f] + i + nx * q, simd::load<V>(cur[f] + i));
+                });
             }
           if (row >= 1) {
             const index_t cbase = base - s;  // cell row−1 receives F_{row−1/2} − F_{row+1/2}

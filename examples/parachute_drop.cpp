@@ -157,6 +157,9 @@ int main(int argc, char** argv) {
   app.add_option("--refine-every", c.refine_every, "blocks: regrid to the canopy every this many steps")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
+  app.add_flag("--refine-column", c.refine_column,
+               "blocks: also hold the finest level on the tensor box's refined column about the axis (from below "
+               "the line confluence to above the crown)");
   app.add_option("--refine-vorticity", c.refine_vorticity,
                  "blocks: also refine the wake where |vorticity| h exceeds this fraction of the payload speed "
                  "(0: off)")

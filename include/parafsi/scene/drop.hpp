@@ -99,6 +99,8 @@ struct drop_config {
   /// blocks: also refine the wake where |ω| h > this × the payload's speed (the velocity
   /// turning by that fraction across a cell; coarsened below a quarter of it); 0 = off
   double refine_vorticity = 0;
+  /// blocks: also hold the finest level on the tensor box's refined column (drop_column_target)
+  bool refine_column = false;
   std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
   /// none | mixing_length (Prandtl's, l_m = min(κ d_w, C_l D0, Δ), d_w from the canopy and
   /// line nodes) | smagorinsky (C_s = 0.1); a closure brings the air's viscosity with it
@@ -157,6 +159,7 @@ struct drop_config {
               "parachute_drop: --refine-vorticity must be in [0, 10] (0: off), got ", refine_vorticity);
     } else {
       require(refine_vorticity == 0, "parachute_drop: --refine-vorticity needs --mesh blocks");
+      require(!refine_column, "parachute_drop: --refine-column needs --mesh blocks");
     }
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
@@ -342,7 +345,8 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
     g.add("mesh", c.mesh)
         .add("block_size", std::int64_t(c.block_size))
         .add("refine_every", std::int64_t(c.refine_every))
-        .add("refine_vorticity", c.refine_vorticity);
+        .add("refine_vorticity", c.refine_vorticity)
+        .add("refine_column", std::int64_t(c.refine_column));
   return g;
 }
 
@@ -613,8 +617,10 @@ class drop_run {
   void regrid() {
     if constexpr (block_mesh) {
       auto& f = s_.fluid();
-      const auto near = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
-                                          levels_, c_.refine_every);
+      const auto canopy = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
+                                            levels_, c_.refine_every);
+      const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column ? levels_ : 0);
+      const auto near = fluid::blocks::max_of{canopy, column};
       bool changed = false;
       if (c_.refine_vorticity > 0) {
         const double U = std::max(1.0, structure::payload(s_.structure()).body().mass_centre_velocity().norm());

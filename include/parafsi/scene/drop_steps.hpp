@@ -88,6 +88,20 @@ fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f
   return {lay, std::move(pts), edge + double(refine_every + 2) * h, level, true};
 }
 
+/// The tensor box's refined block as a block-mesh criterion (--refine-column): `level` on
+/// every block that meets [fine_lo, fine_hi] of the drop box `b` (the column about the
+/// box axis from below the line confluence to above the crown, where the tensor box keeps
+/// its finest cells), 0 elsewhere; the 2:1 balance grades the rest.
+template <class Layout>
+auto drop_column_target(const Layout& lay, const model::drop_box& b, int level) {
+  return [lay, lo = b.fine_lo, hi = b.fine_hi, level](const fluid::blocks::location& q) {
+    const fluid::blocks::block_box bb = fluid::blocks::box_of(lay, q);
+    for (std::size_t d = 0; d < 3; ++d)
+      if (bb.hi[d] <= lo[d] || bb.lo[d] >= hi[d]) return 0;
+    return level;
+  };
+}
+
 /// Place the box `b` of fluid `f` at the payload of `a`: R = the box axes, X = the payload
 /// mass centre, and for a frame that follows the payload (one with `track`) V = the
 /// payload's velocity, so the first stable step accounts for the box speed.

@@ -278,6 +278,8 @@ parafsi_example_refuses(example_parachute_drop_turbulence_inviscid parachute_dro
   "cannot run with --viscosity inviscid" --turbulence mixing_length --viscosity inviscid)
 parafsi_example_refuses(example_parachute_drop_vorticity_tensor parachute_drop "" "--refine-vorticity needs --mesh blocks"
   --refine-vorticity 0.1)
+parafsi_example_refuses(example_parachute_drop_column_tensor parachute_drop "" "--refine-column needs --mesh blocks"
+  --refine-column)
 parafsi_example_refuses(example_parachute_drop_blocks_odd_size parachute_drop "" "--block-size must be even"
   --mesh blocks --coupling penalty --block-size 5)
 # The bundle's mouth diameter outside [0.01, 0.5] D0 (a smaller one would leave elements of ≈ d/D0 of their area).

@@ -2,6 +2,7 @@
 #pragma once
 #include <parafsi/parafsi.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -27,4 +28,26 @@ inline const riemann_case toro_cases[] = {
     {"toro2", {1.0, -2.0, 0.4}, {1.0, 2.0, 0.4}, 0.5, 0.15},
     {"toro3", {1.0, 0.0, 1000.0}, {1.0, 0.0, 0.01}, 0.5, 0.012},
 };
+/// Largest relative difference of the conserved state between a block mesh and a box
+/// solver on the same uniform cells (scaled by |E| + |ρ| of the box cell).
+template <class B, class S>
+double max_block_box_difference(const B& blk, const S& box) {
+  double e = 0;
+  blk.for_each_cell([&](const auto& b, pf::index_t i, pf::index_t j, pf::index_t k) {
+    const auto q = pf::fluid::detail::load_cons(pf::fluid::detail::conserved_ptrs(b.U), b.grid.index(i, j, k));
+    const double x[3] = {b.grid.centre(0, i), b.grid.centre(1, j), b.grid.centre(2, k)};
+    const auto& g = box.grid();
+    pf::index_t I[3];
+    for (int d = 0; d < 3; ++d) {
+      const double h = (g.face(d, g.n(d)) - g.face(d, 0)) / double(g.n(d));
+      I[d] = pf::index_t(std::floor((x[d] - g.face(d, 0)) / h));
+    }
+    const auto r = box.conserved(I[0], I[1], I[2]);
+    const double scale = std::fabs(r.E) + std::fabs(r.rho);
+    e = std::max({e, std::fabs(q.rho - r.rho) / scale, std::fabs(q.m.x - r.m.x) / scale,
+                  std::fabs(q.m.y - r.m.y) / scale, std::fabs(q.m.z - r.m.z) / scale, std::fabs(q.E - r.E) / scale});
+  });
+  return e;
+}
+
 }  // namespace pft

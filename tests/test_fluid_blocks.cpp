@@ -123,26 +123,6 @@ auto twin(std::array<index_t, 3> nb, index_t n, std::array<double, 3> lo, std::a
   fluid::solver box{fluid::rectilinear_grid::uniform({nb[0] * n, nb[1] * n, nb[2] * n}, lo, hi), bc, pol...};
   return std::pair{std::move(blk), std::move(box)};
 }
-/// Largest relative difference of the conserved state over all cells.
-template <class B, class S>
-double max_difference(const B& blk, const S& box) {
-  double e = 0;
-  blk.for_each_cell([&](const auto& b, index_t i, index_t j, index_t k) {
-    const auto q = fluid::detail::load_cons(fluid::detail::conserved_ptrs(b.U), b.grid.index(i, j, k));
-    const Eigen::Vector3d xi{b.grid.centre(0, i), b.grid.centre(1, j), b.grid.centre(2, k)};
-    const auto& g = box.grid();
-    index_t I[3];
-    for (int d = 0; d < 3; ++d) {
-      const double h = (g.face(d, g.n(d)) - g.face(d, 0)) / double(g.n(d));
-      I[d] = index_t(std::floor((xi[d] - g.face(d, 0)) / h));
-    }
-    const auto r = box.conserved(I[0], I[1], I[2]);
-    const double scale = std::fabs(r.E) + std::fabs(r.rho);
-    e = std::max({e, std::fabs(q.rho - r.rho) / scale, std::fabs(q.m.x - r.m.x) / scale,
-                  std::fabs(q.m.y - r.m.y) / scale, std::fabs(q.m.z - r.m.z) / scale, std::fabs(q.E - r.E) / scale});
-  });
-  return e;
-}
 }  // namespace
 
 TEST_CASE("one level of blocks reproduces the box solver to round-off (Sod along each axis, isentropic vortex)") {
@@ -165,7 +145,7 @@ TEST_CASE("one level of blocks reproduces the box solver to round-off (Sod along
       box.step(dt);
       blk.step(dt);
     }
-    const double e = max_difference(blk, box);
+    const double e = pft::max_block_box_difference(blk, box);
     MESSAGE("Sod along axis ", axis, ": 6 blocks of 8^3 vs the 48-cell box after 60 steps: max relative difference ",
             e);
     CHECK(e < 1e-13);
@@ -185,7 +165,7 @@ TEST_CASE("one level of blocks reproduces the box solver to round-off (Sod along
       box.step(dt);
       blk.step(dt);
     }
-    const double e = max_difference(blk, box);
+    const double e = pft::max_block_box_difference(blk, box);
     MESSAGE("isentropic vortex: 16 blocks of 8^3 vs the 32x32x8 box after 40 steps: max relative difference ", e);
     CHECK(e < 1e-13);
   }
@@ -461,7 +441,7 @@ TEST_CASE("block mesh: the far-field sponge and sources match the box solver on 
     box.step(dt);
     blk.step(dt);
   }
-  const double e = max_difference(blk, box);
+  const double e = pft::max_block_box_difference(blk, box);
   MESSAGE("sponge of 4 cells + sources, 12 blocks vs the 24x16x16 box after 40 steps: max relative difference ", e);
   CHECK(e < 1e-13);
   // The sponge reaches exactly the outer 4 cells.

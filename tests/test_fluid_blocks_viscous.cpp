@@ -26,27 +26,6 @@ namespace fb = parafsi::fluid::blocks;
 namespace {
 constexpr double rho0 = 1.0, p0 = 1.0;  // c ≈ 1.18 m/s: viscous and acoustic steps alike
 
-/// Largest relative difference of the conserved state between a block mesh and a box solver
-/// on the same uniform cells.
-template <class B, class S>
-double max_difference(const B& blk, const S& box) {
-  double e = 0;
-  blk.for_each_cell([&](const auto& b, index_t i, index_t j, index_t k) {
-    const auto q = fluid::detail::load_cons(fluid::detail::conserved_ptrs(b.U), b.grid.index(i, j, k));
-    const auto& g = box.grid();
-    index_t I[3];
-    const double x[3] = {b.grid.centre(0, i), b.grid.centre(1, j), b.grid.centre(2, k)};
-    for (int d = 0; d < 3; ++d) {
-      const double h = (g.face(d, g.n(d)) - g.face(d, 0)) / double(g.n(d));
-      I[d] = index_t(std::floor((x[d] - g.face(d, 0)) / h));
-    }
-    const auto r = box.conserved(I[0], I[1], I[2]);
-    const double scale = std::fabs(r.E) + std::fabs(r.rho);
-    e = std::max({e, std::fabs(q.rho - r.rho) / scale, std::fabs(q.m.x - r.m.x) / scale,
-                  std::fabs(q.m.y - r.m.y) / scale, std::fabs(q.m.z - r.m.z) / scale, std::fabs(q.E - r.E) / scale});
-  });
-  return e;
-}
 }  // namespace
 
 TEST_CASE("viscous block mesh: one level reproduces the box solver to round-off, viscous step limit included") {
@@ -70,7 +49,7 @@ TEST_CASE("viscous block mesh: one level reproduces the box solver to round-off,
     const double dt = box.stable_dt(0.5);
     box.step(dt);
     blk.step(dt);
-    worst = std::max(worst, max_difference(blk, box));
+    worst = std::max(worst, pft::max_block_box_difference(blk, box));
   }
   // The inviscid step of the same state, to show the viscous limit is the one that binds.
   fluid::solver inv{fluid::rectilinear_grid::uniform({16, 16, 16}, lay.lo, lay.hi), bc};
@@ -168,7 +147,7 @@ TEST_CASE("eddy viscosity on blocks: one level reproduces the box solver (Smagor
       CHECK(blk.stable_dt(0.5) == doctest::Approx(dt).epsilon(1e-12));
       box.step(dt);
       blk.step(dt);
-      worst = std::max(worst, max_difference(blk, box));
+      worst = std::max(worst, pft::max_block_box_difference(blk, box));
     }
     const auto& g = box.grid();
     for (index_t c = 0; c < g.total_cells(); ++c) mut = std::max(mut, box.eddy_viscosity()[c]);

@@ -763,42 +763,19 @@ class block_solver {
               "fluid::block_solver: patched face ", pi, " (cell ", c, ", axis ", d,
               ") is not between two leaf cells of one level inside the box: the membrane must lie on one level "
               "(refine around it)");
-      const index_t s = b.grid.stride(d), lm = lc - s;  // the low cell in this block's ghost layer if ic = 0
+      // The low cell lies in this block's ghost layer when ic = 0.
       const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
                                                 detail::primitive_ptrs(std::as_const(b.W))};
-      double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
-      auto with_axis = [&](auto&& fn) {
-        if (d == 0) fn(std::integral_constant<int, 0>{});
-        else if (d == 1) fn(std::integral_constant<int, 1>{});
-        else fn(std::integral_constant<int, 2>{});
-      };
-      with_axis([&](auto D) {
-        detail::sweep_cell_faces<decltype(D)::value>(fk, lm, ic - 1, lo_m, hi_m);
-        detail::sweep_cell_faces<decltype(D)::value>(fk, lc, ic, lo_c, hi_c);
-      });
       face_context fc;
       fc.low = m;
       fc.high = c;
-      fc.axis = d;
       fc.stage = stage;
       fc.patch = pi;
-      fc.L = detail::prim_of(hi_m);
-      fc.R = detail::prim_of(lo_c);
-      fc.n = geo.n[std::size_t(d)];
-      fc.centre = detail::face_centre(b.grid, d, lc);
-      fc.wn = detail::face_speed(geo, d, fc.centre);
-      const int a1 = (d + 1) % 3, a2 = (d + 2) % 3;
-      fc.area = b.grid.width(a1, ijk[std::size_t(a1)]) * b.grid.width(a2, ijk[std::size_t(a2)]);
-      const cons<double> F = flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
+      const cons<double> F = detail::regular_face(fk, geo, d, lc, fc);
       cons<double> Flo = F, Fhi = F;
       patcher.patch(fc, state, Flo, Fhi);
-      const double idm = b.grid.inv_widths(d)[ic - 1], idc = b.grid.inv_widths(d)[ic];
-      const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
-      const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
-      for (int q = 0; q < 5; ++q) {
-        dU[q][m] += dlo[q] * idm;
-        dU[q][c] -= dhi[q] * idc;
-      }
+      detail::apply_face_patch(F, Flo, Fhi, m, b.grid.inv_widths(d)[ic - 1], true, c, b.grid.inv_widths(d)[ic], true,
+                               dU);
     }
   }
 

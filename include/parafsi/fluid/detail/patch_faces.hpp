@@ -20,6 +20,7 @@
 #pragma once
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "../../core/error.hpp"
@@ -130,6 +131,54 @@ void correct_neighbour_face(const face_kernel<Flux, Recon>& fk, const stage_geom
   }
 }
 
+/// fn(std::integral_constant<int, d>{}) for the run-time axis d.
+template <class Fn>
+void with_axis(int d, Fn&& fn) {
+  if (d == 0) fn(std::integral_constant<int, 0>{});
+  else if (d == 1) fn(std::integral_constant<int, 1>{});
+  else fn(std::integral_constant<int, 2>{});
+}
+
+/// The face between cells c − stride(d) and c of fk's grid (c's index along d: ic): its
+/// geometry and two-sided face states into fc (normal, centre, grid speed, area, L, R), and
+/// its regular (sweep) flux returned. The caller names the cells (fc.low, fc.high), the
+/// stage and the patch.
+template <class Flux, class Recon>
+cons<double> regular_face(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, int d, index_t c,
+                          face_context& fc) {
+  const rectilinear_grid& grid = fk.grid;
+  const auto ijk = grid.ijk(c);
+  const index_t ic = ijk[std::size_t(d)], m = c - grid.stride(d);
+  double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
+  with_axis(d, [&](auto D) {
+    sweep_cell_faces<decltype(D)::value>(fk, m, ic - 1, lo_m, hi_m);
+    sweep_cell_faces<decltype(D)::value>(fk, c, ic, lo_c, hi_c);
+  });
+  fc.axis = d;
+  fc.L = prim_of(hi_m);
+  fc.R = prim_of(lo_c);
+  fc.n = geo.n[std::size_t(d)];
+  fc.centre = face_centre(grid, d, c);
+  fc.wn = face_speed(geo, d, fc.centre);
+  const int a = (d + 1) % 3, b = (d + 2) % 3;
+  fc.area = grid.width(a, ijk[std::size_t(a)]) * grid.width(b, ijk[std::size_t(b)]);
+  return flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
+}
+
+/// The patcher's fluxes into the rates of the face's cells (flat indices of dU):
+/// dU_low += (F − F_lo)/Δx_low, dU_high −= (F − F_hi)/Δx_high; a cell flagged out (a ghost)
+/// is left alone.
+inline void apply_face_patch(const cons<double>& F, const cons<double>& Flo, const cons<double>& Fhi, index_t low,
+                             double inv_dx_low, bool low_in, index_t high, double inv_dx_high, bool high_in,
+                             const fields5<double>& dU) {
+  const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
+  const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
+  for (int q = 0; q < 5; ++q) {
+    if (low_in) dU[q][low] += dlo[q] * inv_dx_low;
+    if (high_in) dU[q][high] -= dhi[q] * inv_dx_high;
+  }
+}
+
 template <class Flux, class Recon, class Patcher>
 void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, const view& state, int stage,
                  const fields5<double>& dU, Patcher& patcher, std::vector<std::uint8_t>& blocked) {
@@ -159,37 +208,18 @@ void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, 
     const index_t c = faces[pi].high;
     const int d = faces[pi].axis;
     const index_t s = grid.stride(d), m = c - s;
-    const auto ijk = grid.ijk(c);  // axis indices of the high cell
-    const index_t ic = ijk[std::size_t(d)];
-    double lo_m[5], hi_m[5], lo_c[5], hi_c[5];
-    auto with_axis = [&](auto&& fn) {
-      if (d == 0) fn(std::integral_constant<int, 0>{});
-      else if (d == 1) fn(std::integral_constant<int, 1>{});
-      else fn(std::integral_constant<int, 2>{});
-    };
-    with_axis([&](auto D) {
-      sweep_cell_faces<decltype(D)::value>(fk, m, ic - 1, lo_m, hi_m);
-      sweep_cell_faces<decltype(D)::value>(fk, c, ic, lo_c, hi_c);
-    });
+    const index_t ic = grid.ijk(c)[std::size_t(d)];  // the high cell's index along d
     face_context fc;
     fc.low = m;
     fc.high = c;
-    fc.axis = d;
     fc.stage = stage;
     fc.patch = pi;
-    fc.L = prim_of(hi_m);
-    fc.R = prim_of(lo_c);
-    fc.n = geo.n[std::size_t(d)];
-    fc.centre = face_centre(grid, d, c);
-    fc.wn = face_speed(geo, d, fc.centre);
-    const int a = (d + 1) % 3, b = (d + 2) % 3;
-    fc.area = grid.width(a, ijk[std::size_t(a)]) * grid.width(b, ijk[std::size_t(b)]);
-    const cons<double> F = flux::ale_flux(fk.flux, fc.L, fc.R, fc.n, fc.wn, fk.gas);
+    const cons<double> F = regular_face(fk, geo, d, c, fc);
     if constexpr (one_sided) {
       // The membrane sees the one-sided face states; the unblocked neighbouring faces are
       // recomputed with them (each once, see the file comment).
       if (interior(faces[pi]))
-        with_axis([&](auto D) {
+        with_axis(d, [&](auto D) {
           double l1[5], h1[5];
           blocked_cell_faces<decltype(D)::value>(fk, blocked, m, ic - 1, l1, h1);
           fc.L = prim_of(h1);
@@ -204,14 +234,8 @@ void patch_faces(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo, 
     }
     cons<double> Flo = F, Fhi = F;
     patcher.patch(fc, state, Flo, Fhi);
-    const double idm = grid.inv_widths(d)[ic - 1], idc = grid.inv_widths(d)[ic];
-    const double dlo[5] = {F.rho - Flo.rho, F.m.x - Flo.m.x, F.m.y - Flo.m.y, F.m.z - Flo.m.z, F.E - Flo.E};
-    const double dhi[5] = {F.rho - Fhi.rho, F.m.x - Fhi.m.x, F.m.y - Fhi.m.y, F.m.z - Fhi.m.z, F.E - Fhi.E};
-    const bool m_interior = ic - 1 >= 0, c_interior = ic < grid.n(d);
-    for (int q = 0; q < 5; ++q) {
-      if (m_interior) dU[q][m] += dlo[q] * idm;
-      if (c_interior) dU[q][c] -= dhi[q] * idc;
-    }
+    apply_face_patch(F, Flo, Fhi, m, grid.inv_widths(d)[ic - 1], ic - 1 >= 0, c, grid.inv_widths(d)[ic], ic < grid.n(d),
+                     dU);
   }
   if constexpr (one_sided)
     for (const patch_face& f : faces) {

@@ -14,7 +14,8 @@
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
 // --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at
 // draft/coarse), pressure-gradient scaling α = 8 with embedded, 1 with penalty (--pgs); embedded coupling with the
-// fabric's Ergun law and its impedance stabilisation, or the paper's penalty coupling
+// fabric's Ergun law on the cloth's normal through-velocity (--through-flow) and its
+// impedance stabilisation, or the paper's penalty coupling
 // (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
 // following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
@@ -209,6 +210,11 @@ int main(int argc, char** argv) {
                  "embedded: impedance (added-mass) stabilisation factor, 0 = off (light fabric is unstable without)")
       ->check(finite)
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--through-flow", c.through_flow,
+                 "embedded: the velocity the fabric's Ergun law acts on: cloth (the cloth's normal through-velocity) "
+                 "or face (each grid face's, too permeable where the cloth is inclined to the grid)")
+      ->check(CLI::IsMember({"cloth", "face"}))
       ->capture_default_str();
   app.add_option("--payload-mass", c.payload_mass, "override: payload mass (kg); default: the scene's")
       ->check(finite)

@@ -6,7 +6,8 @@
 // conservation; the inflow face is not rigid, so it is measured, not V) and the fabric's
 // Ergun law at that velocity with the relative error. `--incline DEG` turns the sheet by
 // DEG about the transverse z axis in a duct `--width-cells` cells wide (default 2
-// upright, 8 inclined), so the cloth crosses the grid's faces as a staircase.
+// upright, 8 inclined), so the cloth crosses the grid's faces as a staircase;
+// `--through-flow face` puts the embedded coupling's law on each face's velocity.
 // CSV `t,pressure_drop,through_velocity`.
 #include "example_common.hpp"
 
@@ -23,7 +24,7 @@ namespace st = pf::structure;
 int main(int argc, char** argv) {
   CLI::App app{"Flat porous fabric in a slip-wall duct: steady pressure drop against the Ergun law"};
   examples::common_options co;
-  std::string fabric = "mat544", coupling = "penalty", out;
+  std::string fabric = "mat544", coupling = "penalty", through_flow = "cloth", out;
   double V = 0.5, pfac = 1.0, t_end = 0.1, incline = 0.0;
   int cells = 40, width_cells = 0;
   examples::add_flux_option(app, co);
@@ -36,6 +37,10 @@ int main(int argc, char** argv) {
   app.add_option("--coupling", coupling,
                  "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
+      ->capture_default_str();
+  app.add_option("--through-flow", through_flow,
+                 "embedded: the velocity the Ergun law acts on, cloth (the cloth's normal) or face (each face's own)")
+      ->check(CLI::IsMember({"cloth", "face"}))
       ->capture_default_str();
   examples::add_cells_option(app, cells, "cells along the 1 m duct", 10);
   app.add_option("--pfac", pfac, "penalty factor PFAC")->check(CLI::Range(1e-4, 1e3))->capture_default_str();
@@ -137,7 +142,12 @@ int main(int argc, char** argv) {
             max_pen);
         return 0;
       };
-      if (coupling == "embedded") return run(pf::coupling::embedded{law});
+      if (coupling == "embedded") {
+        pf::coupling::embedded_options eo;
+        eo.law_on = through_flow == "face" ? pf::coupling::through_flow_law::face_velocity
+                                           : pf::coupling::through_flow_law::cloth_normal;
+        return run(pf::coupling::embedded{law, eo});
+      }
       return run(pf::coupling::penalty{law, po});
     });
   });

@@ -205,6 +205,11 @@ parafsi_example_dir_test(example_parachute_drop_tiny_blocks_mixing_length parach
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks_viscous parachute_drop "history.csv|summary.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "5|1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --viscosity constant --quiet)
+# The embedded coupling with the fabric law on each face's velocity (the rule before 2026-12).
+parafsi_example_dir_test(example_parachute_drop_tiny_through_flow_face parachute_drop "summary.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --through-flow face --quiet)
+parafsi_example_fails(example_parachute_drop_bad_through_flow parachute_drop --through-flow normal --out ${_ex_out}/unused_drop)
 parafsi_example_test(example_parachute_drop_help parachute_drop --help)
 parafsi_example_fails(example_parachute_drop_bad_pgs parachute_drop --pgs 0.5 --out ${_ex_out}/unused_drop)
 parafsi_example_fails(example_parachute_drop_bad_slice_times parachute_drop --slice-times 0.5,abc --out ${_ex_out}/unused_drop)

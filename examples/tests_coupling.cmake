@@ -72,6 +72,11 @@ foreach(c IN ITEMS penalty embedded)
   parafsi_coupling_example(example_coupling_leak_box_${c} leak_box "t,pressure_left,pressure_right,leak_velocity"
     "leak_velocity=" --coupling ${c} --pressure-jump 50 --cells 20 --time 0.005 --quiet)
 endforeach()
+parafsi_coupling_example(example_coupling_porous_screen_inclined_face porous_screen "t,pressure_drop,through_velocity"
+  "pressure_drop=[0-9.e+-]+ through_velocity=" --coupling embedded --through-flow face --incline 30 --fabric mat509
+  --velocity 1 --cells 20 --time 0.005 --quiet)
+parafsi_coupling_example_fails(example_coupling_porous_screen_bad_through_flow porous_screen --through-flow normal
+  --out ${_cpl_out}/unused.csv)
 parafsi_coupling_example(example_coupling_leak_box_embedded_zero leak_box "t,pressure_left,pressure_right,leak_velocity"
   "leak_velocity=0 " --coupling embedded --pressure-jump 50 --cells 20 --time 0.005 --quiet)
 parafsi_coupling_example_fails(example_coupling_porous_screen_bad_coupling porous_screen --coupling foo

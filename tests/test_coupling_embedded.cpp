@@ -67,6 +67,46 @@ TEST_CASE("embedded: the membrane Riemann problem (wall, series layers, transpar
   }
 }
 
+/// The law on the cloth's normal (embedded_options::law_on = cloth_normal): a face normal to x
+/// crossed by a cloth inclined 30° about z, normal m = (cos θ, −sin θ, 0), tangent t ⊥ m.
+TEST_CASE("embedded: the fabric law on the cloth's normal through an inclined face") {
+  using emb = pf::coupling::embedded<pf::porosity::ergun>;
+  const auto& fab = pf::model::fabric_catalogue[2];  // mat509
+  const pf::porosity::ergun law{fab.alpha, fab.beta, fab.thickness};
+  const emb cpl{law};
+  const double th = M_PI / 6, c = std::cos(th), U = 1.5, V = 20.0, p0 = 101325.0, r0 = 1.2;
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitX(), m(std::cos(th), -std::sin(th), 0.0),
+                        t(std::sin(th), std::cos(th), 0.0), zero = Eigen::Vector3d::Zero();
+  // A uniform stream U along x through the cloth: both sides carry the same flow along the cloth,
+  // σ = U sin²θ, and the face that passes the cells' velocity U has u_n = U cos θ on the law.
+  const Eigen::Vector3d u = U * Eigen::Vector3d::UnitX();
+  const double sigma = emb::common_along_cloth(n, m, zero, u, u);
+  CHECK(sigma == doctest::Approx(U * std::sin(th) * std::sin(th)).epsilon(1e-14));
+  const double dp = law.pressure_jump(U * c);
+  const auto s = cpl.solve_face(r0, U, p0 + dp, r0, U, p0, 0.0, 1, c, sigma);
+  CHECK(s.un == doctest::Approx(U * c).epsilon(1e-10));
+  CHECK(s.up == doctest::Approx(U).epsilon(1e-10));
+  CHECK(s.psL - s.psR == doctest::Approx(law.pressure_jump(s.un)).epsilon(1e-9));
+  // With the law on the face velocity the same face is on its law at u_p (c = 1, σ = 0).
+  const auto sf = cpl.solve_face(r0, U, p0 + dp, r0, U, p0, 0.0, 1);
+  CHECK(sf.un == sf.up);
+  CHECK(sf.psL - sf.psR == doctest::Approx(law.pressure_jump(sf.up)).epsilon(1e-9));
+  // A shear layer along the cloth (a stream V t on one side, still air on the other): the two
+  // sides carry no common flow along the cloth, σ = 0 (the mean, V sin θ / 2, would pass air
+  // across the cloth without any pressure difference).
+  CHECK(emb::common_along_cloth(n, m, zero, V * t, zero) == 0.0);
+  CHECK(emb::common_along_cloth(n, m, zero, V * t, 0.25 * V * t) == doctest::Approx(0.25 * V * std::sin(th)));
+  CHECK(emb::common_along_cloth(n, m, zero, V * t, -V * t) == 0.0);
+  // A cloth sliding along itself through still air (v_s = V t): relative to the cloth the air
+  // moves at −V t on both sides, σ = −V sin θ = −w, so u_m = w + u_p = 0: the air stays at rest.
+  const double w = n.dot(V * t), sg = emb::common_along_cloth(n, m, V * t, zero, zero);
+  CHECK(sg == doctest::Approx(-w).epsilon(1e-14));
+  const auto sl = cpl.solve_face(r0, 0.0, p0, r0, 0.0, p0, w, 1, c, sg);
+  CHECK(std::fabs(sl.un) < 1e-12);
+  CHECK(std::fabs(w + sl.up) < 1e-12);
+  CHECK(sl.psL == doctest::Approx(p0).epsilon(1e-14));
+}
+
 TEST_CASE("embedded: a membrane moving faster than a cell per step is rejected with a message") {
   pf::parallel::set_threads(1);
   auto s = ctu::tilted_patch(pf::coupling::embedded{pf::porosity::impermeable{}}, 1.2, 0.5, 1e5, {1000.0, 0.0, 0.0});

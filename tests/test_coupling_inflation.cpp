@@ -4,11 +4,13 @@
 // E t = 5 kN/m) with pinned edges spans a slip-wall duct; air enters at V = 0.8 m/s
 // and leaves at a fixed pressure. The sheet bulges downstream and comes to rest. The
 // checks are against closed forms and an independent structure-only solution:
-// - steady: the sheet's kinetic energy has decayed to < 1e-4 of its peak (what is left
-//   is the sheet riding the duct's decaying acoustic modes) and the centre deflection
+// - steady: the sheet's kinetic energy has decayed to < 1e-6 of its peak (measured 4.7e-8;
+//   what is left is the sheet riding the duct's decaying acoustic modes) and the centre deflection
 //   changes by < 0.2 % over the last 20 % of the run;
 // - the pressure drop across the sheet follows the Ergun law at the measured
-//   through-velocity within 10 %;
+//   through-velocity within 3 % (the law on the cloth's normal; measured −0.9 %, against
+//   −6.8 % with the law on each face's velocity: the curved sheet crosses faces of all
+//   three axes);
 // - mass conservation: the mass flux ρu up- and downstream of the sheet agree within
 //   1 % (the characteristic inflow face is not rigid: the through-velocity is measured);
 // - the shape: the same sheet relaxed (structure only, dynamic relaxation) under a
@@ -97,8 +99,13 @@ TEST_CASE("a porous membrane blown by a stream reaches a steady inflated shape (
 
   const double t_end = 0.15;
   double k_peak = 0, w_at_80 = 0;
+  // Full steps only (the run ends up to one step after t_end): a last step cut short to land
+  // on t_end would be shorter than the structure's substep, and its first kick, which spans
+  // half the previous substep, then applies the step's fluid impulse over a longer interval
+  // than the step: the load is diluted for that one kick (momentum is still exact) and the
+  // sheet's kinetic energy jumps from ~1e-8 to ~1e-4 of its peak in that single step.
   while (s.time() < t_end - 1e-12) {
-    s.step(std::min(s.stable_dt(0.8), t_end - s.time()));
+    s.step(s.stable_dt(0.8));
     const auto& nd = s.structure().node_set();
     double k = 0;
     for (pf::index_t i = 0; i < nd.size(); ++i) k += nd.velocity(i).squaredNorm();
@@ -171,9 +178,9 @@ TEST_CASE("a porous membrane blown by a stream reaches a steady inflated shape (
 
   CHECK(w_c > 0.0);                                              // bulges downstream
   CHECK(w_c > 0.5 * W / 16);                                     // a real inflation (half a cell or more)
-  CHECK(k_end / k_peak < 1e-4);                                  // at rest
+  CHECK(k_end / k_peak < 1e-6);                                  // at rest
   CHECK(std::fabs(w_c / w_at_80 - 1.0) < 2e-3);                  // steady shape
-  CHECK(std::fabs(dp / dp_ergun - 1.0) < 0.10);                  // the Ergun law holds on the inflated sheet
+  CHECK(std::fabs(dp / dp_ergun - 1.0) < 0.03);                  // the Ergun law holds on the inflated sheet
   CHECK(std::fabs(mass_flux_down / mass_flux_up - 1.0) < 0.01);  // mass through the sheet
   CHECK(std::fabs(w_c / w_ref - 1.0) < 0.05);                    // the shape of a uniformly loaded sheet
   CHECK(profile < 0.05 * w_ref);

@@ -21,14 +21,23 @@
 /// u_m = w + u_p. Each side sees a piston moving at u_m: its wall pressure p*_K comes
 /// from the exact one-sided Riemann problem (Toro §4.2: rarefaction or shock branch,
 /// both inverted in closed form). The fabric law closes the system:
-///   p*_L(u_m) − p*_R(u_m) = k Δp_por(u_p)          (k layers in series)
-/// with the law on the face's through-velocity u_p. A cloth inclined to the grid crosses a
-/// staircase of faces of all three axes, so its through-flow is measured too high by up to
-/// the staircase's area (−6 % and −7.5 % in Δp at 30° and 45°, test_coupling_screen);
-/// docs/coupling.md §7 records the rules tried for the cloth's own normal and why none is
-/// the default yet.
-/// The left side falls and the right rises with u_m, the law rises with u_p, so the
-/// root is unique; it is bracketed and found by the Illinois method. For
+///   p*_L(u_m) − p*_R(u_m) = k Δp_por(u_n),   u_p = c u_n + σ   (k layers in series)
+/// with the law on the cloth's own normal through-velocity u_n (`law_on = cloth_normal`,
+/// the default). A cloth of unit normal m (oriented along n, c = m·n ∈ [0, 1]) inclined to
+/// the grid crosses a staircase of faces of all three axes (area A Σ|m_d| for cloth area A).
+/// The air crossing it moves relative to the cloth at u_n m + s, s ⊥ m, so its face-normal
+/// velocity is u_p = c u_n + s·n. The staircase carries the part of the flow along the cloth
+/// the two sides have in common:
+///   σ = minmod(σ_L, σ_R),   σ_K = n·[r_K − (r_K·m) m],   r_K = u_K − v_s
+/// (v_s the membrane's velocity at the crossing). In a uniform stream through an inclined
+/// screen σ_L = σ_R, the law holds on u_n, and Σ_faces σ A_face = 0 over a plane staircase;
+/// in a shear layer along the cloth (a stream on one side, still air on the other) σ = 0,
+/// so no air crosses where the law lets none through. Normal to the face c = 1, σ = 0.
+/// `law_on = face_velocity`: the law on u_p itself (σ = 0, c = 1), which the staircase of
+/// an inclined cloth makes too permeable (−6 % and −7.5 % in Δp at 30° and 45°,
+/// test_coupling_screen; docs/coupling.md §7 has the rules tried before this one).
+/// The left side falls and the right rises with u_m, the law rises with u_n, so the
+/// root (in u_n) is unique; it is bracketed and found by the Illinois method. For
 /// `porosity::impermeable` u_p = 0 (an exact moving wall). As the resistance → 0 this
 /// becomes the exact Godunov flux (a transparent screen); as it → ∞ the wall.
 /// With W*_K = (ρ*_K, u_K + (u_m − u_K·n) n, p*_K) the star states:
@@ -85,8 +94,20 @@
 
 namespace parafsi::coupling {
 
+/// What velocity the fabric law of a patched face is applied to (file comment, "Face flux").
+enum class through_flow_law {
+  face_velocity,  ///< the face's own through-velocity u_p (the staircase's; too permeable when inclined)
+  cloth_normal    ///< the cloth's normal through-velocity u_n, u_p = c u_n + σ (the default)
+};
+
+inline const char* to_string(through_flow_law l) noexcept {
+  return l == through_flow_law::face_velocity ? "face" : "cloth";
+}
+
 struct embedded_options {
   double max_cells_per_step = 1.0;  ///< reject steps where the membrane moves farther (cells)
+  /// The velocity the fabric law acts on: the cloth's normal (default) or the face's.
+  through_flow_law law_on = through_flow_law::cloth_normal;
   double root_tolerance = 1e-13;    ///< relative tolerance of the through-velocity root
   /// Impedance (added-mass) stabilisation factor ζ ∈ [0, 1]: the structure substeps add
   /// −ζ Σ (ρ_L c_L + ρ_R c_R) A λ n nᵀ (v − vⁿ) to the nodal loads (the linear response of
@@ -98,6 +119,8 @@ struct embedded_options {
             impedance);
     require(max_cells_per_step > 0 && std::isfinite(max_cells_per_step),
             "coupling::embedded: max_cells_per_step must be > 0, got ", max_cells_per_step);
+    require(law_on == through_flow_law::face_velocity || law_on == through_flow_law::cloth_normal,
+            "coupling::embedded: law_on must be face_velocity or cloth_normal");
     require(root_tolerance > 0 && root_tolerance < 1e-3,
             "coupling::embedded: root_tolerance must be in (0, 1e-3), got ", root_tolerance);
   }
@@ -165,6 +188,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   static void serialize(Archive& ar, Self& self) {
     ar.check("porosity", std::string(Porosity::name()), "the porosity law");
     ar.check("impedance", self.opt_.impedance, "the impedance factor");
+    ar.check("law_on", std::string(to_string(self.opt_.law_on)), "the velocity the fabric law acts on");
     ar.check("triangles", std::int64_t(self.tris_.size()), "the number of coupled triangles");
     ar.check("open", std::int64_t(self.open_list_.size()), "the number of open elements");
   }
@@ -369,19 +393,24 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   /// The membrane Riemann problem of one face: through-velocity u_p (relative to the
   /// membrane, along the face normal) and the two wall pressures, given the normal
   /// velocities of the cell states, the membrane's normal velocity w and k layers.
+  /// With the cloth's normal: c = m·n and σ the common along-cloth part (file comment); the
+  /// unknown is then u_n and u_p = c u_n + σ (c = 1, σ = 0: the law on u_p).
   struct face_solution {
     double up = 0, psL = 0, rsL = 0, psR = 0, rsR = 0;
+    double un = 0;  ///< the through-velocity the law acts on (u_n; = up when c = 1, σ = 0)
   };
   face_solution solve_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
-                           int layers) const {
+                           int layers, double c = 1.0, double sigma = 0.0) const {
     face_solution s;
-    auto eval = [&](double up, face_solution& o) {
+    auto eval = [&](double un, face_solution& o) {
+      const double up = c * un + sigma;
       const double um = w + up;
       wall_state(rL, pL, gamma_, unL - um, o.psL, o.rsL);
       wall_state(rR, pR, gamma_, um - unR, o.psR, o.rsR);
       o.up = up;
+      o.un = un;
       double g = o.psL - o.psR;
-      if constexpr (Porosity::permeable) g -= double(layers) * por_.pressure_jump(up);
+      if constexpr (Porosity::permeable) g -= double(layers) * por_.pressure_jump(un);
       return g;
     };
     const double g0 = eval(0.0, s);
@@ -437,6 +466,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     double z;                      ///< crossing coordinate along the face axis (box)
     double wn = 0;                 ///< membrane velocity at the crossing · face normal (m/s)
     double sign = 1;               ///< sign of n_element · n_face
+    Eigen::Vector3d vs = Eigen::Vector3d::Zero();  ///< membrane velocity at the crossing (m/s)
+    Eigen::Vector3d m = Eigen::Vector3d::Zero();   ///< unit cloth normal, oriented along n_face
   };
   struct face_rec {
     index_t high;  ///< the fluid's cell above the face (flat index of its arrays)
@@ -542,8 +573,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
               const double ss = s0 + s1 + s2;
               crossing cr{e, {s0 / ss, s1 / ss, s2 / ss}, z};
               const Eigen::Vector3d nf = pose.R.col(d);
-              cr.wn = nf.dot(cr.lambda[0] * Vn[0] + cr.lambda[1] * Vn[1] + cr.lambda[2] * Vn[2]);
+              cr.vs = cr.lambda[0] * Vn[0] + cr.lambda[1] * Vn[1] + cr.lambda[2] * Vn[2];
+              cr.wn = nf.dot(cr.vs);
               cr.sign = ne.dot(nf) >= 0 ? 1.0 : -1.0;
+              cr.m = (cr.sign / ne.norm()) * ne;
               found.push_back({g.index(ijk[0], ijk[1], ijk[2]), d, cr});
             }
           }
@@ -595,6 +628,39 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     diag_.crossings = index_t(crossings_.size());
   }
 
+  /// c = m·n and σ = minmod(σ_L, σ_R) of a face (file comment), m and v_s the means over
+  /// its layers.
+  void cloth_normal_terms(const face_rec& fr, const Eigen::Vector3d& n, const Eigen::Vector3d& uL,
+                          const Eigen::Vector3d& uR, double& c, double& sigma) const {
+    Eigen::Vector3d m = Eigen::Vector3d::Zero(), vs = Eigen::Vector3d::Zero();
+    for (int q = 0; q < fr.n; ++q) {
+      const auto& cr = crossings_[std::size_t(fr.first + q)];
+      m += cr.m;
+      vs += cr.vs;
+    }
+    const double mn = m.norm();
+    if (!(mn > 0)) return;  // layers of opposite normals: keep the law on the face velocity
+    m /= mn;
+    vs /= double(fr.n);
+    c = std::clamp(m.dot(n), 0.0, 1.0);
+    sigma = common_along_cloth(n, m, vs, uL, uR);
+  }
+
+ public:
+  /// σ = minmod(σ_L, σ_R), σ_K = n·[r_K − (r_K·m) m], r_K = u_K − v_s: the face-normal part of
+  /// the flow along the cloth (unit normal m, velocity v_s) that both sides carry (file comment).
+  static double common_along_cloth(const Eigen::Vector3d& n, const Eigen::Vector3d& m, const Eigen::Vector3d& vs,
+                                   const Eigen::Vector3d& uL, const Eigen::Vector3d& uR) noexcept {
+    auto along = [&](const Eigen::Vector3d& u) {
+      const Eigen::Vector3d r = u - vs;
+      return n.dot(r - r.dot(m) * m);
+    };
+    const double sL = along(uL), sR = along(uR);
+    return sL * sR > 0 ? (std::fabs(sL) < std::fabs(sR) ? sL : sR) : 0.0;
+  }
+
+ private:
+
   /// The membrane flux of patched face fc.patch at stage fc.stage.
   void face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
                  fluid::cons<double>& hi) {
@@ -624,7 +690,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
       rR = v.density(fc.high), uR = v.velocity(fc.high), pR = v.pressure(fc.high);
     }
     const double unL = uL.dot(n), unR = uR.dot(n);
-    const face_solution s = solve_face(rL, unL, pL, rR, unR, pR, w, fr.n);
+    double c = 1.0, sigma = 0.0;
+    if (Porosity::permeable && opt_.law_on == through_flow_law::cloth_normal)
+      cloth_normal_terms(fr, n, uL, uR, c, sigma);
+    const face_solution s = solve_face(rL, unL, pL, rR, unR, pR, w, fr.n, c, sigma);
     const double um = w + s.up, sw = w - fc.wn;
     const Eigen::Vector3d usL = uL + (um - unL) * n, usR = uR + (um - unR) * n;
     const double g1 = 1.0 / (gamma_ - 1.0);

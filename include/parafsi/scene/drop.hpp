@@ -114,6 +114,9 @@ struct drop_config {
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
   double membrane_damping = 0.05;                                ///< membrane damping ratio of its highest mode
   double impedance = 1.0;        ///< embedded: impedance (added-mass) stabilisation factor ζ
+  /// embedded: the velocity the fabric law acts on, cloth (the cloth's normal) or face
+  /// (each grid face's own, the rule before 2026-12; coupling::through_flow_law)
+  std::string through_flow = "cloth";
   double pgs_alpha = 0.0;        ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
   double cell = 0, element = 0;  ///< overrides of the resolution (/ D0), 0 = the resolution's
   double initial_speed = -1;     ///< override of the scene's release speed (m/s), < 0 = scene
@@ -141,6 +144,8 @@ struct drop_config {
     require(one_of(canopy, {"paper", "c9"}), "parachute_drop: canopy must be paper or c9, got '", canopy, "'");
     require(one_of(coupling, {"embedded", "penalty"}), "parachute_drop: coupling must be embedded or penalty, got '",
             coupling, "'");
+    require(one_of(through_flow, {"cloth", "face"}), "parachute_drop: through-flow must be cloth or face, got '",
+            through_flow, "'");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
     require(one_of(turbulence, {"none", "mixing_length", "smagorinsky"}),
@@ -335,6 +340,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("pfac", c.pfac).add("stiffening", c.stiffening).add("coupling_damping", c.coupling_damping);
   g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
   if (c.turbulence != "none") g.add("turbulence", c.turbulence);
+  if (c.coupling == "embedded") g.add("through_flow", c.through_flow);
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
@@ -787,6 +793,8 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
       if (c.coupling == "embedded") {
         coupling::embedded_options eo;
         eo.impedance = c.impedance;
+        eo.law_on = c.through_flow == "face" ? coupling::through_flow_law::face_velocity
+                                             : coupling::through_flow_law::cloth_normal;
         using C = coupling::embedded<porosity::ergun>;
         detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
         return run.run(progress);
@@ -810,6 +818,8 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
     if (c.coupling == "embedded") {
       coupling::embedded_options eo;
       eo.impedance = c.impedance;
+      eo.law_on = c.through_flow == "face" ? coupling::through_flow_law::face_velocity
+                                           : coupling::through_flow_law::cloth_normal;
       return go(coupling::embedded{law, eo});
     }
     coupling::penalty_options po;

@@ -108,7 +108,7 @@ struct embedded_options {
   double max_cells_per_step = 1.0;  ///< reject steps where the membrane moves farther (cells)
   /// The velocity the fabric law acts on: the cloth's normal (default) or the face's.
   through_flow_law law_on = through_flow_law::cloth_normal;
-  double root_tolerance = 1e-13;    ///< relative tolerance of the through-velocity root
+  double root_tolerance = 1e-13;  ///< relative tolerance of the through-velocity root
   /// Impedance (added-mass) stabilisation factor ζ ∈ [0, 1]: the structure substeps add
   /// −ζ Σ (ρ_L c_L + ρ_R c_R) A λ n nᵀ (v − vⁿ) to the nodal loads (the linear response of
   /// the face pressures to the membrane's velocity change within the step). 0 (default):
@@ -399,8 +399,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     double up = 0, psL = 0, rsL = 0, psR = 0, rsR = 0;
     double un = 0;  ///< the through-velocity the law acts on (u_n; = up when c = 1, σ = 0)
   };
-  face_solution solve_face(double rL, double unL, double pL, double rR, double unR, double pR, double w,
-                           int layers, double c = 1.0, double sigma = 0.0) const {
+  face_solution solve_face(double rL, double unL, double pL, double rR, double unR, double pR, double w, int layers,
+                           double c = 1.0, double sigma = 0.0) const {
     face_solution s;
     auto eval = [&](double un, face_solution& o) {
       const double up = c * un + sigma;
@@ -462,10 +462,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
  private:
   struct crossing {
     index_t elem;
-    std::array<double, 3> lambda;  ///< barycentric weights of the crossing point
-    double z;                      ///< crossing coordinate along the face axis (box)
-    double wn = 0;                 ///< membrane velocity at the crossing · face normal (m/s)
-    double sign = 1;               ///< sign of n_element · n_face
+    std::array<double, 3> lambda;                  ///< barycentric weights of the crossing point
+    double z;                                      ///< crossing coordinate along the face axis (box)
+    double wn = 0;                                 ///< membrane velocity at the crossing · face normal (m/s)
+    double sign = 1;                               ///< sign of n_element · n_face
     Eigen::Vector3d vs = Eigen::Vector3d::Zero();  ///< membrane velocity at the crossing (m/s)
     Eigen::Vector3d m = Eigen::Vector3d::Zero();   ///< unit cloth normal, oriented along n_face
   };
@@ -660,7 +660,6 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   }
 
  private:
-
   /// The membrane flux of patched face fc.patch at stage fc.stage.
   void face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
                  fluid::cons<double>& hi) {

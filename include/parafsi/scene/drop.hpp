@@ -113,7 +113,7 @@ struct drop_config {
   double cfl = 0.9;   ///< CFL number of the fluid step
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
   double membrane_damping = 0.05;                                ///< membrane damping ratio of its highest mode
-  double impedance = 1.0;        ///< embedded: impedance (added-mass) stabilisation factor ζ
+  double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
   /// embedded: the velocity the fabric law acts on, cloth (the cloth's normal) or face
   /// (each grid face's own, the rule before 2026-12; coupling::through_flow_law)
   std::string through_flow = "cloth";

@@ -126,6 +126,28 @@ TEST_CASE("summary of a vertical synthetic drop") {
   CHECK(s.csv_row().rfind("mat544,", 0) == 0);
 }
 
+TEST_CASE("F_p is the opening load: a larger force peak in descent is not it") {
+  // The synthetic drop (opening pulse 45 N at 0.45 s, overshoot at 0.7 s) with a 60 N spike
+  // of 30 ms at 5 s, in steady descent: the overshoot scan ends at the first sample 1 % of
+  // D_s below the overshoot (≈ 0.73 s), and F_p, t_p (filtered) and F_p_raw, t_p_raw are
+  // those of the opening pulse.
+  auto h = synthetic(6.0, 0.005, 0.7, 5.0);
+  for (auto& r : h) r.open_force += 60.0 * std::exp(-std::pow((r.t - 5.0) / 0.03, 2));
+  const auto s = io::summarize(h, "late spike");
+  CHECK(s.t_mo == Approx(0.7).epsilon(1e-9));
+  const double sp = 0.05 / std::sqrt(2.0), sg = std::sqrt(std::log(2.0)) / (20 * std::numbers::pi);
+  CHECK(s.t_p == Approx(0.45).epsilon(1e-9));
+  CHECK(s.F_p == Approx(5 + 40 * sp / std::sqrt(sp * sp + sg * sg)).epsilon(2e-4));
+  CHECK(s.t_p_raw == Approx(0.45).epsilon(1e-9));
+  CHECK(s.F_p_raw == Approx(45.0).epsilon(1e-9));
+  // A canopy that never reaches its steady diameter's band again (no fall after the
+  // overshoot) keeps the whole history as its opening: then the late spike is the peak.
+  auto g = h;
+  for (auto& r : g) r.canopy_diameter = std::min(0.7, 0.2 + 0.5 * r.t / 0.5);
+  const auto sg2 = io::summarize(g, "no overshoot");
+  CHECK(sg2.t_p_raw == Approx(5.0).epsilon(1e-9));
+}
+
 // ------------------------------------------------------------------ the force filter
 // io/gaussian_filter.hpp: σ = √ln2/(2π f_c); G(f) = exp(−2π²σ²f²) is 1/√2 at f_c.
 TEST_CASE("zero-phase filter: constants and lines pass unchanged, edges included; the cut-off is -3 dB") {

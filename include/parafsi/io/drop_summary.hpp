@@ -36,9 +36,14 @@
 ///           the (first) sample at M. A wiggle smaller than that band does not end it; a
 ///           diameter that never falls back by the band gives its largest value after t_f.
 ///           (The global maximum, often a later breathing peak, is `t_max_diameter`.)
-///   t_p, F_p  time and value of the peak of open_force_filtered, computed here with the
-///           same filter (`force_cutoff`, `sample_interval`) as the history column, so the
-///           two agree bit for bit; the raw sample maximum is t_p_raw, F_p_raw
+///   t_p, F_p  time and value of the peak of open_force_filtered over the opening, computed
+///           here with the same filter (`force_cutoff`, `sample_interval`) as the history
+///           column, so the two agree bit for bit; the raw sample maximum over the opening
+///           is t_p_raw, F_p_raw. The opening: from the first sample to the one that ends
+///           the overshoot scan of t_mo (the diameter fallen back by the band below its
+///           overshoot), or the whole history when the canopy does not fall back or never
+///           reaches D_s. A later peak of the ringing in descent (a filtered 18.8 N at 5.7 s
+///           above the 18.2 N opening of the permeable mat509) is not the opening load.
 ///   v_terminal, cd_terminal  means of speed and drag_coefficient over the last `window` s
 ///   attitude_amplitude  peak canopy tilt from the vertical over the last `window` s, the
 ///           tilt of the axis with angles (φx, φy): atan(√(tan²φx + tan²φy))
@@ -401,13 +406,16 @@ inline descent_statistics classify_descent(std::span<const drop_history_row> w, 
 
 /// The inflation overshoot (rule in the file comment): the index of the first maximum of
 /// the canopy diameter at or after index `from`, a scan ended by a fall of `drop` below the
-/// running maximum.
-inline std::size_t first_diameter_maximum(std::span<const drop_history_row> h, std::size_t from, double drop) {
-  std::size_t im = from;
-  for (std::size_t i = from; i < h.size(); ++i) {
+/// running maximum; `end` (if given) receives the index of the sample that ended the scan
+/// (h.size() − 1 when none did).
+inline std::size_t first_diameter_maximum(std::span<const drop_history_row> h, std::size_t from, double drop,
+                                          std::size_t* end = nullptr) {
+  std::size_t im = from, i = from;
+  for (; i < h.size(); ++i) {
     if (h[i].canopy_diameter > h[im].canopy_diameter) im = i;
     if (h[i].canopy_diameter <= h[im].canopy_diameter - drop) break;
   }
+  if (end) *end = std::min(i, h.size() - 1);
   return im;
 }
 
@@ -437,24 +445,12 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   s.steady_diameter = sumD / nd;
   s.v_terminal = sumV / nd;
   s.cd_terminal = ncd > 0 ? sumCd / ncd : std::numeric_limits<double>::quiet_NaN();
-  // Peaks: the raw and the filtered open force (the filter of the history column), the
-  // largest diameter.
-  const gaussian_lowpass lp = open_force_lowpass(h, o);
-  const auto force = [&](std::size_t j) { return h[j].open_force; };
-  std::size_t imax = 0, ip = 0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
+  // The largest diameter.
+  std::size_t imax = 0;
+  for (std::size_t i = 0; i < h.size(); ++i)
     if (h[i].canopy_diameter > h[imax].canopy_diameter) imax = i;
-    if (h[i].open_force > h[ip].open_force) ip = i;
-    const double Ff = lp.at(h.size(), i, force);
-    if (i == 0 || Ff > s.F_p) {
-      s.F_p = Ff;
-      s.t_p = h[i].t;
-    }
-  }
   s.t_max_diameter = h[imax].t;
   s.max_diameter = h[imax].canopy_diameter;
-  s.t_p_raw = h[ip].t;
-  s.F_p_raw = h[ip].open_force;
   // Full inflation: first crossing of the steady diameter.
   std::size_t i_f = h.size();
   for (std::size_t i = 0; i < h.size(); ++i) {
@@ -470,12 +466,29 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
       break;
     }
   }
-  // The inflation overshoot, from the first sample at or above D_s.
+  // The inflation overshoot, from the first sample at or above D_s; the opening ends where
+  // its scan ends.
+  std::size_t i_open = h.size() - 1;
   if (i_f < h.size()) {
-    const std::size_t imo = first_diameter_maximum(h, i_f, o.overshoot_drop * s.steady_diameter);
+    const std::size_t imo = first_diameter_maximum(h, i_f, o.overshoot_drop * s.steady_diameter, &i_open);
     s.t_mo = h[imo].t;
     s.overshoot_diameter = h[imo].canopy_diameter;
   }
+  // The opening load: peaks of the raw and the filtered open force (the filter of the
+  // history column) over the opening, samples 0 … i_open.
+  const gaussian_lowpass lp = open_force_lowpass(h, o);
+  const auto force = [&](std::size_t j) { return h[j].open_force; };
+  std::size_t ip = 0;
+  for (std::size_t i = 0; i <= i_open; ++i) {
+    if (h[i].open_force > h[ip].open_force) ip = i;
+    const double Ff = lp.at(h.size(), i, force);
+    if (i == 0 || Ff > s.F_p) {
+      s.F_p = Ff;
+      s.t_p = h[i].t;
+    }
+  }
+  s.t_p_raw = h[ip].t;
+  s.F_p_raw = h[ip].open_force;
   // Descent mode over the rows after full inflation.
   s.descent = classify_descent(h.subspan(i_f < h.size() ? i_f : 0), s.v_terminal, o);
   s.descent_mode = s.descent.mode;

@@ -41,8 +41,9 @@
 ///           column, so the two agree bit for bit; the raw sample maximum over the opening
 ///           is t_p_raw, F_p_raw. The opening: from the first sample to the one that ends
 ///           the overshoot scan of t_mo (the diameter fallen back by the band below its
-///           overshoot), or the whole history when the canopy does not fall back or never
-///           reaches D_s. A later peak of the ringing in descent (a filtered 18.8 N at 5.7 s
+///           overshoot) if that sample lies before the last `window` seconds (where D_s is
+///           averaged); the whole history when the canopy does not fall back, never reaches
+///           D_s, or the run is too short to have a steady window (a run of the opening alone). A later peak of the ringing in descent (a filtered 18.8 N at 5.7 s
 ///           above the 18.2 N opening of the permeable mat509) is not the opening load.
 ///   v_terminal, cd_terminal  means of speed and drag_coefficient over the last `window` s
 ///   attitude_amplitude  peak canopy tilt from the vertical over the last `window` s, the
@@ -470,9 +471,13 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   // its scan ends.
   std::size_t i_open = h.size() - 1;
   if (i_f < h.size()) {
-    const std::size_t imo = first_diameter_maximum(h, i_f, o.overshoot_drop * s.steady_diameter, &i_open);
+    std::size_t i_scan = i_open;
+    const std::size_t imo = first_diameter_maximum(h, i_f, o.overshoot_drop * s.steady_diameter, &i_scan);
     s.t_mo = h[imo].t;
     s.overshoot_diameter = h[imo].canopy_diameter;
+    // Only a scan that ends before the window D_s is averaged over closes the opening (a
+    // run of the opening alone has no steady diameter to fall back to).
+    if (h[i_scan].t < t_w) i_open = i_scan;
   }
   // The opening load: peaks of the raw and the filtered open force (the filter of the
   // history column) over the opening, samples 0 … i_open.

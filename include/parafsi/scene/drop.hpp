@@ -340,7 +340,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("pfac", c.pfac).add("stiffening", c.stiffening).add("coupling_damping", c.coupling_damping);
   g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
   if (c.turbulence != "none") g.add("turbulence", c.turbulence);
-  if (c.coupling == "embedded") g.add("through_flow", c.through_flow);
+  g.add("through_flow", c.through_flow);
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);

@@ -119,9 +119,8 @@ void run_blocks(const char* fname, const char* rname, int n, int nb, int threads
       return d2 < o.sphere * o.sphere;
     });
   const pf::fluid::block_layout layout{{0, 0, 0}, {1, 1, 1}, {roots, roots, roots}, nb};
-  pf::fluid::block_solver s{std::move(tree), layout, pf::boundary::set::all(pf::boundary::periodic{}),
-                            Flux{},          Recon{}, Visc{},
-                            Turb{}};
+  pf::fluid::block_solver s{std::move(tree), layout, pf::boundary::set::all(pf::boundary::periodic{}), Flux{}, Recon{},
+                            Visc{},          Turb{}};
   s.initialize(smooth_field);
   pf::fluid::phase_times ph;
   const auto rates = time_steps(s, double(s.cell_count()), o, ph);
@@ -142,8 +141,9 @@ struct meshes {
     return std::find(viscosity.begin(), viscosity.end(), v) != viscosity.end() &&
            std::find(turbulence.begin(), turbulence.end(), t) != turbulence.end();
   }
-  bool any_viscous() const { return !(viscosity == std::vector<std::string>{"inviscid"} && turbulence ==
-                                      std::vector<std::string>{"none"}); }
+  bool any_viscous() const {
+    return !(viscosity == std::vector<std::string>{"inviscid"} && turbulence == std::vector<std::string>{"none"});
+  }
 };
 
 template <class Flux, class Recon, class Visc, class Turb>
@@ -164,8 +164,7 @@ void run(const char* fname, const char* rname, int n, int t, const meshes& m, co
   if constexpr (std::is_same_v<Flux, pf::flux::hllc_lm> &&
                 std::is_same_v<Recon, pf::recon::muscl<pf::limiter::van_leer>>) {
     run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::constant, tu::none>{"constant", "none"});
-    run_models<Flux, Recon>(fname, rname, n, t, m, o,
-                            models<vi::constant, tu::smagorinsky>{"constant", "smagorinsky"});
+    run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::constant, tu::smagorinsky>{"constant", "smagorinsky"});
     run_models<Flux, Recon>(fname, rname, n, t, m, o,
                             models<vi::constant, tu::prandtl_mixing_length>{"constant", "mixing_length"});
     run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::inviscid, tu::smagorinsky>{"inviscid", "smagorinsky"});

@@ -239,7 +239,10 @@ struct viscous_pass {
             const V ih = d == 0 ? simd::load<V>(inv_h + i) : V(inv_h[d == 1 ? j : k]);
             for (int q = 0; q < 4; ++q) {
               const V a0 = d == 0 ? V(0.0) : simd::load<V>(acc[q] + c);
-              simd::store(acc[q] + c, a0 + (simd::load<V>(Fv[q] + c + s) - simd::load<V>(Fv[q] + c)) * ih);
+              const V a = a0 + (simd::load<V>(Fv[q] + c + s) - simd::load<V>(Fv[q] + c)) * ih;
+              // 4. After the last axis, the sum into the rates.
+              if constexpr (d == 2) simd::store(dU[q + 1] + c, simd::load<V>(dU[q + 1] + c) + a);
+              else simd::store(acc[q] + c, a);
             }
           });
         }
@@ -248,18 +251,6 @@ struct viscous_pass {
     axis_pass.template operator()<0>();
     axis_pass.template operator()<1>();
     axis_pass.template operator()<2>();
-    // 4. The sum into the rates.
-    par_for(threaded, 0, nz, [&](index_t k) {
-      for (index_t j = 0; j < ny; ++j) {
-        const index_t base = grid.index(0, j, k);
-        lanes(0, nx, [&](auto tag, index_t i) {
-          using V = typename decltype(tag)::type;
-          const index_t c = base + i;
-          for (int q = 0; q < 4; ++q)
-            simd::store(dU[q + 1] + c, simd::load<V>(dU[q + 1] + c) + simd::load<V>(acc[q] + c));
-        });
-      }
-    });
   }
 };
 

@@ -8,14 +8,18 @@
 /// buffer indexed by its high cell), then every cell takes the differences of its two
 /// faces per axis, summed over the axes in the order x, y, z:
 ///   dU_c += Σ_d (F̂_v,d(c + s_d) − F̂_v,d(c)) / Δx_d.
-/// Every phase runs on SIMD lanes along x (pointwise physics on V, scalar tail): box-frame
-/// velocity and temperature, cell gradients with μ(T) and μ_t, the face fluxes, their
-/// differences and the sum into dU. Each value gets the operations of the scalar pass
-/// (Lanes = 1, kept as the reference) in the same order: the rotations reproduce Eigen's
-/// 3×3 product (rotate below), and the filter width Δ = (h_x h_y h_z)^{1/3} is std::cbrt lane
-/// by lane, reused along a row while h_x repeats. Without contraction of a b + c
-/// (-ffp-contract=off) packs and scalars agree bit for bit; with it (the default where the
-/// hardware has FMA) the compiler fuses some sums differently in the two: round-off.
+/// Phases: box-frame velocity and temperature on every cell (with μ(T) and k_eff when there
+/// is no eddy viscosity); with eddy viscosity the cell gradients (central differences), |S|,
+/// μ_t and the transport coefficients on cells [−1, n]; per axis the face fluxes, then the
+/// differences (after z straight into dU). No gradient is stored: a face recomputes the two
+/// cells' central differences it needs (the same values). Every phase runs on SIMD lanes
+/// along x (pointwise physics on V, scalar tail), each value with the operations of the
+/// scalar pass (Lanes = 1, kept as the reference) in the same order: the rotations reproduce
+/// Eigen's 3×3 product (rotate below), and the filter width Δ = (h_x h_y h_z)^{1/3} is
+/// std::cbrt lane by lane, reused along a row while h_x repeats. Without contraction of
+/// a b + c (-ffp-contract=off) packs, scalars and the stored-gradient form agree bit for bit;
+/// with it (the default where the hardware has FMA) the compiler fuses some sums differently
+/// in each: round-off.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -99,10 +103,6 @@ struct viscous_pass {
     double* Tc = vs.template get<field::T>();
     double* mu = vs.template get<field::mu_eff>();
     double* kk = vs.template get<field::k_eff>();
-    double* G[3][3] = {{vs.template get<field::g00>(), vs.template get<field::g01>(), vs.template get<field::g02>()},
-                       {vs.template get<field::g10>(), vs.template get<field::g11>(), vs.template get<field::g12>()},
-                       {vs.template get<field::g20>(), vs.template get<field::g21>(), vs.template get<field::g22>()}};
-    double* GT[3] = {vs.template get<field::gT0>(), vs.template get<field::gT1>(), vs.template get<field::gT2>()};
     double* Fv[4] = {vs.template get<field::fv0>(), vs.template get<field::fv1>(), vs.template get<field::fv2>(),
                      vs.template get<field::fv3>()};
     double* acc[4] = {vs.template get<field::av0>(), vs.template get<field::av1>(), vs.template get<field::av2>(),
@@ -113,7 +113,8 @@ struct viscous_pass {
     const Eigen::Matrix3d Rt = geo.R.transpose();
     const double cp = gas.cp();
     const gas::ideal g = gas;
-    // 1. Box-frame velocity and temperature on every cell (ghosts included).
+    // 1. Box-frame velocity and temperature on every cell (ghosts included); without eddy
+    //    viscosity also the transport coefficients.
     const index_t N = grid.total_cells();
     const index_t chunk = 4096;
     par_for(threaded, 0, (N + chunk - 1) / chunk, [&](index_t ch) {
@@ -123,45 +124,53 @@ struct viscous_pass {
         V u[3];
         rotate(Rt, w, u);
         for (int a = 0; a < 3; ++a) simd::store(ub[a] + c, u[a]);
-        simd::store(Tc + c, g.temperature(simd::load<V>(Wr + c), simd::load<V>(Wp + c)));
+        const V T = g.temperature(simd::load<V>(Wr + c), simd::load<V>(Wp + c));
+        simd::store(Tc + c, T);
+        if constexpr (!has_eddy_viscosity) {
+          const V mu_l = visc.mu(T), mut = V(0.0);
+          simd::store(mu + c, mu_l + mut);
+          simd::store(kk + c, V(cp) * (mu_l / V(visc.prandtl) + mut / V(turb.prandtl_t)));
+        }
       });
     });
-    // 2. Cell gradients (central differences) and transport coefficients on cells
-    //    [−1, n] in every direction.
-    const double* xcs[3] = {grid.centres(0), grid.centres(1), grid.centres(2)};
-    const double* hx = grid.widths(0);
+    // Central differences of the cell at c along axis e (inv: 1 / the distance between its
+    // two neighbours' centres), of the box velocity (a = 0, 1, 2) and of T (a = 3).
     const index_t sd[3] = {grid.stride(0), grid.stride(1), grid.stride(2)};
-    par_for(threaded, -1, nz + 1, [&](index_t k) {
-      for (index_t j = -1; j < ny + 1; ++j) {
-        const index_t base = grid.index(0, j, k);
-        const double inv_y = 1.0 / (xcs[1][j + 1] - xcs[1][j - 1]), inv_z = 1.0 / (xcs[2][k + 1] - xcs[2][k - 1]);
-        const double hy = grid.width(1, j), hz = grid.width(2, k);
-        // Δ of the last cell along the row, reused while h_x repeats (the same product, the same cube root).
-        double h_last = std::numeric_limits<double>::quiet_NaN(), delta_last = 0.0;
-        auto delta_at = [&](index_t i) {
-          if (!(hx[i] == h_last)) {
-            h_last = hx[i];
-            delta_last = std::cbrt(hx[i] * hy * hz);
-          }
-          return delta_last;
-        };
-        lanes(-1, nx + 1, [&](auto tag, index_t i) {
-          using V = typename decltype(tag)::type;
-          const index_t c = base + i;
-          const V inv[3] = {V(1.0) / (simd::load<V>(xcs[0] + i + 1) - simd::load<V>(xcs[0] + i - 1)), V(inv_y),
-                            V(inv_z)};
-          V gr[3][3];
-          for (int d = 0; d < 3; ++d) {
-            const index_t s = sd[d];
-            for (int a = 0; a < 3; ++a) {
-              gr[a][d] = (simd::load<V>(ub[a] + c + s) - simd::load<V>(ub[a] + c - s)) * inv[d];
-              simd::store(G[a][d] + c, gr[a][d]);
+    const double* const q4[4] = {ub[0], ub[1], ub[2], Tc};
+    auto central = [&]<class V>(int a, int e, index_t c, const V& inv) {
+      return (simd::load<V>(q4[a] + c + sd[e]) - simd::load<V>(q4[a] + c - sd[e])) * inv;
+    };
+    const double* xcs[3] = {grid.centres(0), grid.centres(1), grid.centres(2)};
+    auto inv_gap = [&](int e, index_t i) { return 1.0 / (xcs[e][i + 1] - xcs[e][i - 1]); };
+    auto inv_gap_x = [&]<class V>(index_t i) {
+      return V(1.0) / (simd::load<V>(xcs[0] + i + 1) - simd::load<V>(xcs[0] + i - 1));
+    };
+    // 2. With eddy viscosity: the cell gradients (central differences), |S|, μ_t and the
+    //    transport coefficients on cells [−1, n] in every direction.
+    const double* hx = grid.widths(0);
+    if constexpr (has_eddy_viscosity)
+      par_for(threaded, -1, nz + 1, [&](index_t k) {
+        for (index_t j = -1; j < ny + 1; ++j) {
+          const index_t base = grid.index(0, j, k);
+          const double inv_y = inv_gap(1, j), inv_z = inv_gap(2, k);
+          const double hy = grid.width(1, j), hz = grid.width(2, k);
+          // Δ of the last cell along the row, reused while h_x repeats (the same product, the same cube root).
+          double h_last = std::numeric_limits<double>::quiet_NaN(), delta_last = 0.0;
+          auto delta_at = [&](index_t i) {
+            if (!(hx[i] == h_last)) {
+              h_last = hx[i];
+              delta_last = std::cbrt(hx[i] * hy * hz);
             }
-            simd::store(GT[d] + c, (simd::load<V>(Tc + c + s) - simd::load<V>(Tc + c - s)) * inv[d]);
-          }
-          const V mu_l = visc.mu(simd::load<V>(Tc + c));
-          V mut = V(0.0);
-          if constexpr (has_eddy_viscosity) {
+            return delta_last;
+          };
+          lanes(-1, nx + 1, [&](auto tag, index_t i) {
+            using V = typename decltype(tag)::type;
+            const index_t c = base + i;
+            const V inv[3] = {inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
+            V gr[3][3];
+            for (int e = 0; e < 3; ++e)
+              for (int a = 0; a < 3; ++a) gr[a][e] = central(a, e, c, inv[e]);
+            const V mu_l = visc.mu(simd::load<V>(Tc + c));
             V S2 = V(0.0);
             for (int a = 0; a < 3; ++a)
               for (int b = 0; b < 3; ++b) {
@@ -178,28 +187,29 @@ struct viscous_pass {
             }
             V dw = V(1e30);
             if constexpr (needs_wall_distance) dw = simd::load<V>(ts.template get<field::wall_distance>() + c);
-            mut = turb.eddy_viscosity(simd::load<V>(Wr + c), simd::sqrt(V(2.0) * S2), delta, dw);
+            const V mut = turb.eddy_viscosity(simd::load<V>(Wr + c), simd::sqrt(V(2.0) * S2), delta, dw);
             simd::store(ts.template get<field::mu_t>() + c, mut);
-          }
-          simd::store(mu + c, mu_l + mut);
-          simd::store(kk + c, V(cp) * (mu_l / V(visc.prandtl) + mut / V(turb.prandtl_t)));
-        });
-      }
-    });
+            simd::store(mu + c, mu_l + mut);
+            simd::store(kk + c, V(cp) * (mu_l / V(visc.prandtl) + mut / V(turb.prandtl_t)));
+          });
+        }
+      });
     // 3. Face fluxes of one axis into Fv (at the face's high cell), then every cell's
     //    difference across the axis into acc (race-free, thread-count independent).
-    //    idc: 1/(distance between the two cells' centres) of the faces.
-    auto face = [&]<int d, class V>(index_t cc, const V& idc) {
+    //    idc: 1/(distance between the two cells' centres) of the faces; inv[e]: the two
+    //    cells' central-difference factors along the other axes (the same for both).
+    auto face = [&]<int d, class V>(index_t cc, const V& idc, const V(&inv)[3]) {
       const index_t cm = cc - sd[d];
-      // Gradient at the face: normal from the two cells, tangential averaged.
+      // Gradient at the face: normal from the two cells, tangential the average of the two
+      // cells' central differences.
       V gf[3][3], gT[3];
       for (int e = 0; e < 3; ++e) {
         if (e == d) {
           for (int a = 0; a < 3; ++a) gf[a][e] = (simd::load<V>(ub[a] + cc) - simd::load<V>(ub[a] + cm)) * idc;
           gT[e] = (simd::load<V>(Tc + cc) - simd::load<V>(Tc + cm)) * idc;
         } else {
-          for (int a = 0; a < 3; ++a) gf[a][e] = V(0.5) * (simd::load<V>(G[a][e] + cm) + simd::load<V>(G[a][e] + cc));
-          gT[e] = V(0.5) * (simd::load<V>(GT[e] + cm) + simd::load<V>(GT[e] + cc));
+          for (int a = 0; a < 3; ++a) gf[a][e] = V(0.5) * (central(a, e, cm, inv[e]) + central(a, e, cc, inv[e]));
+          gT[e] = V(0.5) * (central(3, e, cm, inv[e]) + central(3, e, cc, inv[e]));
         }
       }
       const V muf = V(0.5) * (simd::load<V>(mu + cm) + simd::load<V>(mu + cc));
@@ -222,10 +232,12 @@ struct viscous_pass {
       par_for(threaded, 0, top[2], [&](index_t k) {
         for (index_t j = 0; j < top[1]; ++j) {
           const index_t base = grid.index(0, j, k);
+          const double inv_y = d == 1 ? 0.0 : inv_gap(1, j), inv_z = d == 2 ? 0.0 : inv_gap(2, k);
           lanes(0, top[0], [&](auto tag, index_t i) {
             using V = typename decltype(tag)::type;
             const V id = d == 0 ? simd::load<V>(idc + i) : V(idc[d == 1 ? j : k]);
-            face.template operator()<d, V>(base + i, id);
+            const V inv[3] = {d == 0 ? V(0.0) : inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
+            face.template operator()<d, V>(base + i, id, inv);
           });
         }
       });

@@ -10,8 +10,9 @@
 ///   dU_c += Σ_d (F̂_v,d(c + s_d) − F̂_v,d(c)) / Δx_d.
 /// Phases: box-frame velocity and temperature on every cell (with μ(T) and k_eff when there
 /// is no eddy viscosity); with eddy viscosity the cell gradients (central differences), |S|,
-/// μ_t and the transport coefficients on cells [−1, n]; per axis the face fluxes, then the
-/// differences (after z straight into dU). No gradient is stored: a face recomputes the two
+/// μ_t and the transport coefficients on cells [−1, n]; per axis the face fluxes row by row,
+/// each row's differences as soon as its faces are there (after z straight into dU); the
+/// hook sees each axis's complete face buffer. No gradient is stored: a face recomputes the two
 /// cells' central differences it needs (the same values). Every phase runs on SIMD lanes
 /// along x (pointwise physics on V, scalar tail), each value with the operations of the
 /// scalar pass (Lanes = 1, kept as the reference) in the same order: the rotations reproduce
@@ -39,6 +40,8 @@ namespace parafsi::fluid::detail {
 /// What the viscous pass does with an axis's face fluxes besides differencing them: nothing
 /// (the box solver); a block of a block mesh keeps its boundary faces' for the coarse–fine
 /// correction (hook(d, Fv): Fv[q][c] the flux of the face below cell c, q = momentum x, y, z, energy).
+/// It is called once every face of axis d is in Fv, and reads them (the differences may
+/// have been taken already).
 struct no_face_hook {
   void operator()(int, double* const*) const noexcept {}
 };
@@ -194,8 +197,8 @@ struct viscous_pass {
           });
         }
       });
-    // 3. Face fluxes of one axis into Fv (at the face's high cell), then every cell's
-    //    difference across the axis into acc (race-free, thread-count independent).
+    // 3. Per axis, face fluxes into Fv (at the face's high cell) and every cell's difference
+    //    across the axis into acc (race-free, thread-count independent).
     //    idc: 1/(distance between the two cells' centres) of the faces; inv[e]: the two
     //    cells' central-difference factors along the other axes (the same for both).
     auto face = [&]<int d, class V>(index_t cc, const V& idc, const V(&inv)[3]) {
@@ -224,45 +227,59 @@ struct viscous_pass {
       for (int a = 0; a < 3; ++a) simd::store(Fv[a] + cc, ti[a]);
       simd::store(Fv[3] + cc, work + kf * gT[d]);
     };
-    auto axis_pass = [&]<int d>() {
-      const index_t s = sd[d];
+    // Faces of row (j, k) along axis d (high cells i = 0 … n_x − 1, and n_x for x faces).
+    auto faces_row = [&]<int d>(index_t j, index_t k) {
       const double* idc = grid.inv_centre_gaps(d);
-      const double* inv_h = grid.inv_widths(d);
-      const index_t top[3] = {nx + (d == 0), ny + (d == 1), nz + (d == 2)};  // faces: high cells 0 … n_d
-      par_for(threaded, 0, top[2], [&](index_t k) {
-        for (index_t j = 0; j < top[1]; ++j) {
-          const index_t base = grid.index(0, j, k);
-          const double inv_y = d == 1 ? 0.0 : inv_gap(1, j), inv_z = d == 2 ? 0.0 : inv_gap(2, k);
-          lanes(0, top[0], [&](auto tag, index_t i) {
-            using V = typename decltype(tag)::type;
-            const V id = d == 0 ? simd::load<V>(idc + i) : V(idc[d == 1 ? j : k]);
-            const V inv[3] = {d == 0 ? V(0.0) : inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
-            face.template operator()<d, V>(base + i, id, inv);
-          });
-        }
+      const index_t base = grid.index(0, j, k);
+      const double inv_y = d == 1 ? 0.0 : inv_gap(1, j), inv_z = d == 2 ? 0.0 : inv_gap(2, k);
+      lanes(0, nx + (d == 0), [&](auto tag, index_t i) {
+        using V = typename decltype(tag)::type;
+        const V id = d == 0 ? simd::load<V>(idc + i) : V(idc[d == 1 ? j : k]);
+        const V inv[3] = {d == 0 ? V(0.0) : inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
+        face.template operator()<d, V>(base + i, id, inv);
       });
-      hook(d, Fv);
-      par_for(threaded, 0, nz, [&](index_t k) {
-        for (index_t j = 0; j < ny; ++j) {
-          const index_t base = grid.index(0, j, k);
-          lanes(0, nx, [&](auto tag, index_t i) {
-            using V = typename decltype(tag)::type;
-            const index_t c = base + i;
-            const V ih = d == 0 ? simd::load<V>(inv_h + i) : V(inv_h[d == 1 ? j : k]);
-            for (int q = 0; q < 4; ++q) {
-              const V a0 = d == 0 ? V(0.0) : simd::load<V>(acc[q] + c);
-              const V a = a0 + (simd::load<V>(Fv[q] + c + s) - simd::load<V>(Fv[q] + c)) * ih;
-              // 4. After the last axis, the sum into the rates.
-              if constexpr (d == 2) simd::store(dU[q + 1] + c, simd::load<V>(dU[q + 1] + c) + a);
-              else simd::store(acc[q] + c, a);
-            }
-          });
+    };
+    // Differences across axis d of the cells of row (j, k) into acc; after z, into dU.
+    auto differences_row = [&]<int d>(index_t j, index_t k) {
+      const index_t s = sd[d];
+      const double* inv_h = grid.inv_widths(d);
+      const index_t base = grid.index(0, j, k);
+      lanes(0, nx, [&](auto tag, index_t i) {
+        using V = typename decltype(tag)::type;
+        const index_t c = base + i;
+        const V ih = d == 0 ? simd::load<V>(inv_h + i) : V(inv_h[d == 1 ? j : k]);
+        for (int q = 0; q < 4; ++q) {
+          const V a0 = d == 0 ? V(0.0) : simd::load<V>(acc[q] + c);
+          const V a = a0 + (simd::load<V>(Fv[q] + c + s) - simd::load<V>(Fv[q] + c)) * ih;
+          // 4. After the last axis, the sum into the rates.
+          if constexpr (d == 2) simd::store(dU[q + 1] + c, simd::load<V>(dU[q + 1] + c) + a);
+          else simd::store(acc[q] + c, a);
         }
       });
     };
-    axis_pass.template operator()<0>();
-    axis_pass.template operator()<1>();
-    axis_pass.template operator()<2>();
+    // Each row's differences right after the faces they need (still in cache): x rows
+    // by themselves, y rows walking j in each plane k, z rows walking k for each j.
+    par_for(threaded, 0, nz, [&](index_t k) {
+      for (index_t j = 0; j < ny; ++j) {
+        faces_row.template operator()<0>(j, k);
+        differences_row.template operator()<0>(j, k);
+      }
+    });
+    hook(0, Fv);
+    par_for(threaded, 0, nz, [&](index_t k) {
+      for (index_t j = 0; j <= ny; ++j) {
+        faces_row.template operator()<1>(j, k);
+        if (j > 0) differences_row.template operator()<1>(j - 1, k);
+      }
+    });
+    hook(1, Fv);
+    par_for(threaded, 0, ny, [&](index_t j) {
+      for (index_t k = 0; k <= nz; ++k) {
+        faces_row.template operator()<2>(j, k);
+        if (k > 0) differences_row.template operator()<2>(j, k - 1);
+      }
+    });
+    hook(2, Fv);
   }
 };
 

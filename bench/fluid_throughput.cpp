@@ -6,6 +6,7 @@
 //   fluid_throughput [--cells 64,128] [--threads 1,2] [--repeats 5] [--steps 3]
 //                    [--flux all|hllc_lm|...] [--recon all|van_leer|...]
 //                    [--mesh tensor,blocks] [--block-size 8,16,32] [--refine-sphere R] [--phases]
+//                    [--viscosity inviscid,constant] [--turbulence none,smagorinsky,mixing_length]
 //
 // --mesh tensor (the default) runs fluid::solver on the N³ box; --mesh blocks runs
 // fluid::block_solver on the same cells as one level of (N/N_b)³ blocks of N_b³ cells
@@ -14,6 +15,10 @@
 // radius R·(box edge) about the box centre by one level (two levels; `cells=` is then the
 // leaf-cell count and the rate counts leaf cells). --phases adds a `# phases` line per
 // run: seconds per step in each of the solver's timed phases.
+// --viscosity (inviscid: the default; constant: air's μ, Pr = 0.72) and --turbulence (none: the
+// default; smagorinsky; mixing_length: Prandtl's, no wall-distance field, so l_m = min(C_l L_ref, Δ))
+// add the viscous pass; every combination listed runs, the viscous ones with HLLC-LM + van Leer
+// only. Every line ends in `viscosity=... turbulence=...`.
 #include <parafsi/parafsi.hpp>
 
 #include <CLI/CLI.hpp>
@@ -22,6 +27,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace pf = parafsi;
@@ -63,28 +69,40 @@ std::vector<double> time_steps(S& s, double cells, const settings& o, pf::fluid:
 }
 
 void print_phases(const pf::fluid::phase_times& p) {
-  std::printf("# phases s/step: boundaries=%.4g primitives=%.4g fluxes=%.4g update=%.4g total=%.4g\n", p.boundaries,
-              p.primitives, p.fluxes, p.update, p.total());
+  std::printf(
+      "# phases s/step: boundaries=%.4g primitives=%.4g fluxes=%.4g update=%.4g total=%.4g viscous=%.4g "
+      "sources=%.4g\n",
+      p.boundaries, p.primitives, p.fluxes, p.update, p.total(), p.viscous, p.sources);
 }
 
-template <class Flux, class Recon>
-void run_tensor(const char* fname, const char* rname, int n, int threads, const settings& o) {
+/// The physical models of a run: viscosity and turbulence policies and their names.
+template <class Visc, class Turb>
+struct models {
+  const char* visc_name;
+  const char* turb_name;
+};
+
+template <class Flux, class Recon, class Visc, class Turb>
+void run_tensor(const char* fname, const char* rname, int n, int threads, const settings& o,
+                const models<Visc, Turb>& md) {
   pf::parallel::set_threads(threads);
   auto grid = pf::fluid::rectilinear_grid::uniform({n, n, n}, {0, 0, 0}, {1, 1, 1});
-  pf::fluid::solver s{grid, pf::boundary::set::all(pf::boundary::periodic{}), Flux{}, Recon{}};
+  pf::fluid::solver s{grid, pf::boundary::set::all(pf::boundary::periodic{}), Flux{}, Recon{}, Visc{}, Turb{}};
   s.initialize(smooth_field);
   pf::fluid::phase_times ph;
   const auto rates = time_steps(s, double(n) * n * n, o, ph);
   std::printf(
       "fluid_throughput flux=%s recon=%s cells=%d threads=%d cell_updates_per_s=%.4g"
-      " min=%.4g max=%.4g simd_width=%zu\n",
-      fname, rname, n * n * n, threads, rates[rates.size() / 2], rates.front(), rates.back(), pf::simd::width);
+      " min=%.4g max=%.4g simd_width=%zu viscosity=%s turbulence=%s\n",
+      fname, rname, n * n * n, threads, rates[rates.size() / 2], rates.front(), rates.back(), pf::simd::width,
+      md.visc_name, md.turb_name);
   if (o.phases) print_phases(ph);
   std::fflush(stdout);
 }
 
-template <class Flux, class Recon>
-void run_blocks(const char* fname, const char* rname, int n, int nb, int threads, const settings& o) {
+template <class Flux, class Recon, class Visc, class Turb>
+void run_blocks(const char* fname, const char* rname, int n, int nb, int threads, const settings& o,
+                const models<Visc, Turb>& md) {
   pf::parallel::set_threads(threads);
   const pf::index_t roots = n / nb;
   pf::fluid::blocks::tree tree({roots, roots, roots}, {true, true, true});
@@ -101,15 +119,16 @@ void run_blocks(const char* fname, const char* rname, int n, int nb, int threads
       return d2 < o.sphere * o.sphere;
     });
   const pf::fluid::block_layout layout{{0, 0, 0}, {1, 1, 1}, {roots, roots, roots}, nb};
-  pf::fluid::block_solver s{std::move(tree), layout, pf::boundary::set::all(pf::boundary::periodic{}), Flux{}, Recon{}};
+  pf::fluid::block_solver s{std::move(tree), layout, pf::boundary::set::all(pf::boundary::periodic{}), Flux{}, Recon{},
+                            Visc{},          Turb{}};
   s.initialize(smooth_field);
   pf::fluid::phase_times ph;
   const auto rates = time_steps(s, double(s.cell_count()), o, ph);
   std::printf(
       "fluid_throughput flux=%s recon=%s cells=%lld threads=%d cell_updates_per_s=%.4g"
-      " min=%.4g max=%.4g simd_width=%zu mesh=blocks block=%d levels=%d\n",
+      " min=%.4g max=%.4g simd_width=%zu mesh=blocks block=%d levels=%d viscosity=%s turbulence=%s\n",
       fname, rname, static_cast<long long>(s.cell_count()), threads, rates[rates.size() / 2], rates.front(),
-      rates.back(), pf::simd::width, nb, s.tree().finest_level() + 1);
+      rates.back(), pf::simd::width, nb, s.tree().finest_level() + 1, md.visc_name, md.turb_name);
   if (o.phases) print_phases(ph);
   std::fflush(stdout);
 }
@@ -117,13 +136,41 @@ void run_blocks(const char* fname, const char* rname, int n, int nb, int threads
 struct meshes {
   bool tensor = true, blocks = false;
   std::vector<int> block_sizes{16};
+  std::vector<std::string> viscosity{"inviscid"}, turbulence{"none"};
+  bool wants(const std::string& v, const std::string& t) const {
+    return std::find(viscosity.begin(), viscosity.end(), v) != viscosity.end() &&
+           std::find(turbulence.begin(), turbulence.end(), t) != turbulence.end();
+  }
+  bool any_viscous() const {
+    return !(viscosity == std::vector<std::string>{"inviscid"} && turbulence == std::vector<std::string>{"none"});
+  }
 };
+
+template <class Flux, class Recon, class Visc, class Turb>
+void run_models(const char* fname, const char* rname, int n, int t, const meshes& m, const settings& o,
+                const models<Visc, Turb>& md) {
+  if (!m.wants(md.visc_name, md.turb_name)) return;
+  if (m.tensor) run_tensor<Flux, Recon>(fname, rname, n, t, o, md);
+  if (m.blocks)
+    for (int nb : m.block_sizes) run_blocks<Flux, Recon>(fname, rname, n, nb, t, o, md);
+}
 
 template <class Flux, class Recon>
 void run(const char* fname, const char* rname, int n, int t, const meshes& m, const settings& o) {
-  if (m.tensor) run_tensor<Flux, Recon>(fname, rname, n, t, o);
-  if (m.blocks)
-    for (int nb : m.block_sizes) run_blocks<Flux, Recon>(fname, rname, n, nb, t, o);
+  namespace vi = pf::viscosity;
+  namespace tu = pf::turbulence;
+  run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::inviscid, tu::none>{"inviscid", "none"});
+  // The viscous pass with the default scheme only (each model is a solver instantiation).
+  if constexpr (std::is_same_v<Flux, pf::flux::hllc_lm> &&
+                std::is_same_v<Recon, pf::recon::muscl<pf::limiter::van_leer>>) {
+    run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::constant, tu::none>{"constant", "none"});
+    run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::constant, tu::smagorinsky>{"constant", "smagorinsky"});
+    run_models<Flux, Recon>(fname, rname, n, t, m, o,
+                            models<vi::constant, tu::prandtl_mixing_length>{"constant", "mixing_length"});
+    run_models<Flux, Recon>(fname, rname, n, t, m, o, models<vi::inviscid, tu::smagorinsky>{"inviscid", "smagorinsky"});
+    run_models<Flux, Recon>(fname, rname, n, t, m, o,
+                            models<vi::inviscid, tu::prandtl_mixing_length>{"inviscid", "mixing_length"});
+  }
 }
 
 template <class Flux>
@@ -161,7 +208,20 @@ int main(int argc, char** argv) {
                  "level")
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--phases", o.phases, "print seconds per step of each timed phase");
+  app.add_option("--viscosity", m.viscosity, "inviscid and/or constant (air's mu, Pr 0.72)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"inviscid", "constant"}));
+  app.add_option("--turbulence", m.turbulence, "none, smagorinsky and/or mixing_length (Prandtl's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"none", "smagorinsky", "mixing_length"}));
   CLI11_PARSE(app, argc, argv);
+  if (m.any_viscous() && (flux != "hllc_lm" || recon != "van_leer")) {
+    std::fprintf(stderr,
+                 "fluid_throughput: --viscosity/--turbulence other than inviscid/none run with --flux hllc_lm "
+                 "--recon van_leer only; got --flux %s --recon %s\n",
+                 flux.c_str(), recon.c_str());
+    return 1;
+  }
   m.tensor = std::find(mesh.begin(), mesh.end(), "tensor") != mesh.end();
   m.blocks = std::find(mesh.begin(), mesh.end(), "blocks") != mesh.end();
   if (m.blocks)

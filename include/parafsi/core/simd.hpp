@@ -87,6 +87,8 @@ PARAFSI_INLINE double sqrt(double a) noexcept { return std::sqrt(a); }
 PARAFSI_INLINE double sin(double a) noexcept { return std::sin(a); }
 PARAFSI_INLINE double pow(double a, double b) noexcept { return std::pow(a, b); }
 PARAFSI_INLINE double copysign(double a, double b) noexcept { return std::copysign(a, b); }
+/// a b + c rounded once.
+PARAFSI_INLINE double fma(double a, double b, double c) noexcept { return std::fma(a, b, c); }
 template <class A>
 PARAFSI_INLINE auto min(const xsimd::batch<double, A>& a, const xsimd::batch<double, A>& b) noexcept {
   return xsimd::min(a, b);
@@ -114,6 +116,11 @@ PARAFSI_INLINE auto pow(const xsimd::batch<double, A>& a, const xsimd::batch<dou
 template <class A>
 PARAFSI_INLINE auto copysign(const xsimd::batch<double, A>& a, const xsimd::batch<double, A>& b) noexcept {
   return xsimd::copysign(a, b);
+}
+template <class A>
+PARAFSI_INLINE auto fma(const xsimd::batch<double, A>& a, const xsimd::batch<double, A>& b,
+                        const xsimd::batch<double, A>& c) noexcept {
+  return xsimd::fma(a, b, c);
 }
 
 /// True if any / all lanes of a mask are set.

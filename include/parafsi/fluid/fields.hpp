@@ -2,7 +2,7 @@
 /// Field tags of the fluid solver's cell arrays (structure-of-arrays storage, one
 /// array per tag; core/soa.hpp) and the field lists of its storages:
 ///   conserved U = (ρ, ρu, ρv, ρw, E),  primitive W = (ρ, u, v, w, p),
-///   viscous scratch (box-frame velocity, T, transport coefficients, gradients),
+///   viscous scratch (box-frame velocity, T, transport coefficients, face fluxes),
 ///   turbulence (μ_t, wall distance), sources (per unit volume and time) and sponge σ.
 /// Tags with a `name` are written by the checkpoint and field output under that name.
 #pragma once
@@ -40,25 +40,13 @@ struct w {
 struct p {
   static constexpr const char* name = "p";
 };
-// Viscous scratch: box-frame velocity, temperature, transport coefficients, gradients.
+// Viscous scratch: box-frame velocity, temperature, transport coefficients.
 struct ub0 {};
 struct ub1 {};
 struct ub2 {};
 struct T {};
 struct mu_eff {};
 struct k_eff {};
-struct g00 {};
-struct g01 {};
-struct g02 {};
-struct g10 {};
-struct g11 {};
-struct g12 {};
-struct g20 {};
-struct g21 {};
-struct g22 {};
-struct gT0 {};
-struct gT1 {};
-struct gT2 {};
 // Viscous face fluxes of one axis (at the face's high cell) and their per-cell sums.
 struct fv0 {};
 struct fv1 {};
@@ -96,10 +84,8 @@ struct sponge_sigma {};
 
 using conserved_fields = meta::list<field::rho, field::mx, field::my, field::mz, field::E>;
 using primitive_fields = meta::list<field::rho, field::u, field::v, field::w, field::p>;
-using viscous_fields = meta::list<field::ub0, field::ub1, field::ub2, field::T, field::mu_eff, field::k_eff, field::g00,
-                                  field::g01, field::g02, field::g10, field::g11, field::g12, field::g20, field::g21,
-                                  field::g22, field::gT0, field::gT1, field::gT2, field::fv0, field::fv1, field::fv2,
-                                  field::fv3, field::av0, field::av1, field::av2, field::av3>;
+using viscous_fields = meta::list<field::ub0, field::ub1, field::ub2, field::T, field::mu_eff, field::k_eff, field::fv0,
+                                  field::fv1, field::fv2, field::fv3, field::av0, field::av1, field::av2, field::av3>;
 using source_fields = meta::list<field::s_mx, field::s_my, field::s_mz, field::s_E, field::s_rho>;
 
 }  // namespace parafsi::fluid

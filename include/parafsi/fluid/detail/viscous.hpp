@@ -8,11 +8,28 @@
 /// buffer indexed by its high cell), then every cell takes the differences of its two
 /// faces per axis, summed over the axes in the order x, y, z:
 ///   dU_c += Σ_d (F̂_v,d(c + s_d) − F̂_v,d(c)) / Δx_d.
+/// Phases: box-frame velocity and temperature on every cell (with μ(T) and k_eff when there
+/// is no eddy viscosity); with eddy viscosity the cell gradients (central differences), |S|,
+/// μ_t and the transport coefficients on cells [−1, n]; per axis the face fluxes row by row,
+/// each row's differences as soon as its faces are there (after z straight into dU); the
+/// hook sees each axis's complete face buffer. No gradient is stored: a face recomputes the two
+/// cells' central differences it needs (the same values). Every phase runs on SIMD lanes
+/// along x (pointwise physics on V, scalar tail), each value with the operations of the
+/// scalar pass (Lanes = 1, kept as the reference) in the same order: the rotations reproduce
+/// Eigen's 3×3 product (rotate below), and the filter width Δ = (h_x h_y h_z)^{1/3} is
+/// std::cbrt lane by lane, reused along a row while h_x repeats. Without contraction of
+/// a b + c (-ffp-contract=off) packs, scalars and the stored-gradient form agree bit for bit;
+/// with it (the default where the hardware has FMA) the compiler fuses some sums differently
+/// in each: round-off.
 #pragma once
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <limits>
 
 #include <Eigen/Core>
 
+#include "../../core/simd.hpp"
 #include "../fields.hpp"
 #include "../gas.hpp"
 #include "../grid.hpp"
@@ -23,13 +40,43 @@ namespace parafsi::fluid::detail {
 /// What the viscous pass does with an axis's face fluxes besides differencing them: nothing
 /// (the box solver); a block of a block mesh keeps its boundary faces' for the coarse–fine
 /// correction (hook(d, Fv): Fv[q][c] the flux of the face below cell c, q = momentum x, y, z, energy).
+/// It is called once every face of axis d is in Fv, and reads them (the differences may
+/// have been taken already).
 struct no_face_hook {
   void operator()(int, double* const*) const noexcept {}
 };
 
-/// Everything the viscous pass reads and writes.
-template <class Viscosity, class Turbulence, class ViscStorage, class TurbStorage>
+/// y = M x on V with the arithmetic of Eigen 3.4's Matrix3d × Vector3d, so that the pass
+/// gives the Eigen product's values. Where Eigen vectorizes, rows 0 and 1 are one packet:
+/// M(·,0) x_0, then multiply-adds with columns 1 and 2 (fused when it vectorizes with FMA);
+/// row 2 (every row without vectorization) is the sum M(r,0) x_0 + (M(r,2) x_2 + M(r,1) x_1).
+/// Where the compiler contracts a b + c (the default -ffp-contract=fast with FMA hardware) it
+/// may fuse that sum differently on packs than on scalars (a difference at round-off).
+template <class V>
+PARAFSI_INLINE void rotate(const Eigen::Matrix3d& M, const V (&x)[3], V (&y)[3]) noexcept {
+  auto row_sum = [&](int r) { return V(M(r, 0)) * x[0] + (V(M(r, 2)) * x[2] + V(M(r, 1)) * x[1]); };
+#if defined(EIGEN_VECTORIZE) && !defined(EIGEN_DONT_VECTORIZE)
+  for (int r = 0; r < 2; ++r) {
+    const V y0 = V(M(r, 0)) * x[0];
+#if defined(EIGEN_VECTORIZE_FMA)
+    y[r] = simd::fma(V(M(r, 2)), x[2], simd::fma(V(M(r, 1)), x[1], y0));
+#else
+    y[r] = V(M(r, 1)) * x[1] + y0;
+    y[r] = V(M(r, 2)) * x[2] + y[r];
+#endif
+  }
+#else
+  y[0] = row_sum(0);
+  y[1] = row_sum(1);
+#endif
+  y[2] = row_sum(2);
+}
+
+/// Everything the viscous pass reads and writes. Lanes: cells per SIMD pack along x
+/// (simd::width), or 1 for the scalar pass.
+template <class Viscosity, class Turbulence, class ViscStorage, class TurbStorage, std::size_t Lanes = simd::width>
 struct viscous_pass {
+  static_assert(Lanes == 1 || Lanes == simd::width, "viscous_pass: Lanes must be 1 or simd::width");
   static constexpr bool has_eddy_viscosity = Turbulence::active;
   static constexpr bool needs_wall_distance = [] {
     if constexpr (Turbulence::active) return Turbulence::needs_wall_distance;
@@ -44,6 +91,13 @@ struct viscous_pass {
   TurbStorage& ts;
   bool threaded;
 
+  /// f(tag, i) over [b, e): packs and a scalar tail, or scalars only.
+  template <class F>
+  static PARAFSI_INLINE void lanes(index_t b, index_t e, F&& f) {
+    if constexpr (Lanes == 1) simd::for_each_scalar(b, e, f);
+    else simd::for_each_pack(b, e, f);
+  }
+
   template <class FaceHook = no_face_hook>
   void operator()(const stage_geometry& geo, const fields5<const double>& W, const fields5<double>& dU,
                   const FaceHook& hook = {}) {
@@ -52,10 +106,6 @@ struct viscous_pass {
     double* Tc = vs.template get<field::T>();
     double* mu = vs.template get<field::mu_eff>();
     double* kk = vs.template get<field::k_eff>();
-    double* G[3][3] = {{vs.template get<field::g00>(), vs.template get<field::g01>(), vs.template get<field::g02>()},
-                       {vs.template get<field::g10>(), vs.template get<field::g11>(), vs.template get<field::g12>()},
-                       {vs.template get<field::g20>(), vs.template get<field::g21>(), vs.template get<field::g22>()}};
-    double* GT[3] = {vs.template get<field::gT0>(), vs.template get<field::gT1>(), vs.template get<field::gT2>()};
     double* Fv[4] = {vs.template get<field::fv0>(), vs.template get<field::fv1>(), vs.template get<field::fv2>(),
                      vs.template get<field::fv3>()};
     double* acc[4] = {vs.template get<field::av0>(), vs.template get<field::av1>(), vs.template get<field::av2>(),
@@ -65,114 +115,171 @@ struct viscous_pass {
     const double* Wp = W[4];
     const Eigen::Matrix3d Rt = geo.R.transpose();
     const double cp = gas.cp();
-    // 1. Box-frame velocity and temperature on every cell (ghosts included).
+    const gas::ideal g = gas;
+    // 1. Box-frame velocity and temperature on every cell (ghosts included); without eddy
+    //    viscosity also the transport coefficients.
     const index_t N = grid.total_cells();
-    par_for(threaded, 0, N, [&](index_t c) {
-      const Eigen::Vector3d u = Rt * Eigen::Vector3d(Wu[0][c], Wu[1][c], Wu[2][c]);
-      ub[0][c] = u[0];
-      ub[1][c] = u[1];
-      ub[2][c] = u[2];
-      Tc[c] = gas.temperature(Wr[c], Wp[c]);
+    const index_t chunk = 4096;
+    par_for(threaded, 0, (N + chunk - 1) / chunk, [&](index_t ch) {
+      lanes(ch * chunk, std::min(N, ch * chunk + chunk), [&](auto tag, index_t c) {
+        using V = typename decltype(tag)::type;
+        const V w[3] = {simd::load<V>(Wu[0] + c), simd::load<V>(Wu[1] + c), simd::load<V>(Wu[2] + c)};
+        V u[3];
+        rotate(Rt, w, u);
+        for (int a = 0; a < 3; ++a) simd::store(ub[a] + c, u[a]);
+        const V T = g.temperature(simd::load<V>(Wr + c), simd::load<V>(Wp + c));
+        simd::store(Tc + c, T);
+        if constexpr (!has_eddy_viscosity) {
+          const V mu_l = visc.mu(T), mut = V(0.0);
+          simd::store(mu + c, mu_l + mut);
+          simd::store(kk + c, V(cp) * (mu_l / V(visc.prandtl) + mut / V(turb.prandtl_t)));
+        }
+      });
     });
-    // 2. Cell gradients (central differences) and transport coefficients on cells
-    //    [−1, n] in every direction.
+    // Central differences of the cell at c along axis e (inv: 1 / the distance between its
+    // two neighbours' centres), of the box velocity (a = 0, 1, 2) and of T (a = 3).
+    const index_t sd[3] = {grid.stride(0), grid.stride(1), grid.stride(2)};
+    const double* const q4[4] = {ub[0], ub[1], ub[2], Tc};
+    auto central = [&]<class V>(int a, int e, index_t c, const V& inv) {
+      return (simd::load<V>(q4[a] + c + sd[e]) - simd::load<V>(q4[a] + c - sd[e])) * inv;
+    };
     const double* xcs[3] = {grid.centres(0), grid.centres(1), grid.centres(2)};
-    par_for(threaded, -1, nz + 1, [&](index_t k) {
-      for (index_t j = -1; j < ny + 1; ++j)
-        for (index_t i = -1; i < nx + 1; ++i) {
-          const index_t c = grid.index(i, j, k);
-          const index_t ijk[3] = {i, j, k};
-          for (int d = 0; d < 3; ++d) {
-            const index_t s = grid.stride(d);
-            const double inv = 1.0 / (xcs[d][ijk[d] + 1] - xcs[d][ijk[d] - 1]);
-            for (int a = 0; a < 3; ++a) G[a][d][c] = (ub[a][c + s] - ub[a][c - s]) * inv;
-            GT[d][c] = (Tc[c + s] - Tc[c - s]) * inv;
-          }
-          double mu_l = visc.mu(Tc[c]);
-          double mut = 0.0;
-          if constexpr (has_eddy_viscosity) {
-            double S2 = 0.0;
+    auto inv_gap = [&](int e, index_t i) { return 1.0 / (xcs[e][i + 1] - xcs[e][i - 1]); };
+    auto inv_gap_x = [&]<class V>(index_t i) {
+      return V(1.0) / (simd::load<V>(xcs[0] + i + 1) - simd::load<V>(xcs[0] + i - 1));
+    };
+    // 2. With eddy viscosity: the cell gradients (central differences), |S|, μ_t and the
+    //    transport coefficients on cells [−1, n] in every direction.
+    const double* hx = grid.widths(0);
+    if constexpr (has_eddy_viscosity)
+      par_for(threaded, -1, nz + 1, [&](index_t k) {
+        for (index_t j = -1; j < ny + 1; ++j) {
+          const index_t base = grid.index(0, j, k);
+          const double inv_y = inv_gap(1, j), inv_z = inv_gap(2, k);
+          const double hy = grid.width(1, j), hz = grid.width(2, k);
+          // Δ of the last cell along the row, reused while h_x repeats (the same product, the same cube root).
+          double h_last = std::numeric_limits<double>::quiet_NaN(), delta_last = 0.0;
+          auto delta_at = [&](index_t i) {
+            if (!(hx[i] == h_last)) {
+              h_last = hx[i];
+              delta_last = std::cbrt(hx[i] * hy * hz);
+            }
+            return delta_last;
+          };
+          lanes(-1, nx + 1, [&](auto tag, index_t i) {
+            using V = typename decltype(tag)::type;
+            const index_t c = base + i;
+            const V inv[3] = {inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
+            V gr[3][3];
+            for (int e = 0; e < 3; ++e)
+              for (int a = 0; a < 3; ++a) gr[a][e] = central(a, e, c, inv[e]);
+            const V mu_l = visc.mu(simd::load<V>(Tc + c));
+            V S2 = V(0.0);
             for (int a = 0; a < 3; ++a)
               for (int b = 0; b < 3; ++b) {
-                const double sab = 0.5 * (G[a][b][c] + G[b][a][c]);
+                const V sab = V(0.5) * (gr[a][b] + gr[b][a]);
                 S2 += sab * sab;
               }
-            const double delta = std::cbrt(grid.width(0, i) * grid.width(1, j) * grid.width(2, k));
-            double dw = 1e30;
-            if constexpr (needs_wall_distance) dw = ts.template get<field::wall_distance>()[c];
-            mut = turb.eddy_viscosity(Wr[c], std::sqrt(2.0 * S2), delta, dw);
-            ts.template get<field::mu_t>()[c] = mut;
-          }
-          mu[c] = mu_l + mut;
-          kk[c] = cp * (mu_l / visc.prandtl + mut / turb.prandtl_t);
+            V delta;
+            if constexpr (simd::is_pack_v<V>) {
+              alignas(64) double dl[V::size];
+              for (std::size_t l = 0; l < V::size; ++l) dl[l] = delta_at(i + index_t(l));
+              delta = simd::load_aligned<V>(dl);
+            } else {
+              delta = delta_at(i);
+            }
+            V dw = V(1e30);
+            if constexpr (needs_wall_distance) dw = simd::load<V>(ts.template get<field::wall_distance>() + c);
+            const V mut = turb.eddy_viscosity(simd::load<V>(Wr + c), simd::sqrt(V(2.0) * S2), delta, dw);
+            simd::store(ts.template get<field::mu_t>() + c, mut);
+            simd::store(mu + c, mu_l + mut);
+            simd::store(kk + c, V(cp) * (mu_l / V(visc.prandtl) + mut / V(turb.prandtl_t)));
+          });
         }
-    });
-    // 3. Face fluxes of one axis into Fv (at the face's high cell), then every cell's
-    //    difference across the axis into acc (race-free, thread-count independent).
-    auto face = [&](int d, index_t cm, index_t cc, double idc, index_t out) {
-      // Gradient at the face: normal from the two cells, tangential averaged.
-      double g[3][3], gT[3];
+      });
+    // 3. Per axis, face fluxes into Fv (at the face's high cell) and every cell's difference
+    //    across the axis into acc (race-free, thread-count independent).
+    //    idc: 1/(distance between the two cells' centres) of the faces; inv[e]: the two
+    //    cells' central-difference factors along the other axes (the same for both).
+    auto face = [&]<int d, class V>(index_t cc, const V& idc, const V(&inv)[3]) {
+      const index_t cm = cc - sd[d];
+      // Gradient at the face: normal from the two cells, tangential the average of the two
+      // cells' central differences.
+      V gf[3][3], gT[3];
       for (int e = 0; e < 3; ++e) {
         if (e == d) {
-          for (int a = 0; a < 3; ++a) g[a][e] = (ub[a][cc] - ub[a][cm]) * idc;
-          gT[e] = (Tc[cc] - Tc[cm]) * idc;
+          for (int a = 0; a < 3; ++a) gf[a][e] = (simd::load<V>(ub[a] + cc) - simd::load<V>(ub[a] + cm)) * idc;
+          gT[e] = (simd::load<V>(Tc + cc) - simd::load<V>(Tc + cm)) * idc;
         } else {
-          for (int a = 0; a < 3; ++a) g[a][e] = 0.5 * (G[a][e][cm] + G[a][e][cc]);
-          gT[e] = 0.5 * (GT[e][cm] + GT[e][cc]);
+          for (int a = 0; a < 3; ++a) gf[a][e] = V(0.5) * (central(a, e, cm, inv[e]) + central(a, e, cc, inv[e]));
+          gT[e] = V(0.5) * (central(3, e, cm, inv[e]) + central(3, e, cc, inv[e]));
         }
       }
-      const double muf = 0.5 * (mu[cm] + mu[cc]), kf = 0.5 * (kk[cm] + kk[cc]);
-      const double div = g[0][0] + g[1][1] + g[2][2];
-      double tau[3];
-      for (int a = 0; a < 3; ++a) tau[a] = muf * (g[a][d] + g[d][a] - (a == d ? 2.0 / 3.0 * div : 0.0));
-      double work = 0.0;
-      for (int a = 0; a < 3; ++a) work += tau[a] * 0.5 * (ub[a][cm] + ub[a][cc]);
-      const Eigen::Vector3d ti = geo.R * Eigen::Vector3d(tau[0], tau[1], tau[2]);
-      Fv[0][out] = ti[0];
-      Fv[1][out] = ti[1];
-      Fv[2][out] = ti[2];
-      Fv[3][out] = work + kf * gT[d];
+      const V muf = V(0.5) * (simd::load<V>(mu + cm) + simd::load<V>(mu + cc));
+      const V kf = V(0.5) * (simd::load<V>(kk + cm) + simd::load<V>(kk + cc));
+      const V div = gf[0][0] + gf[1][1] + gf[2][2];
+      V tau[3];
+      for (int a = 0; a < 3; ++a) tau[a] = muf * (gf[a][d] + gf[d][a] - (a == d ? V(2.0 / 3.0) * div : V(0.0)));
+      V work = V(0.0);
+      for (int a = 0; a < 3; ++a) work += tau[a] * V(0.5) * (simd::load<V>(ub[a] + cm) + simd::load<V>(ub[a] + cc));
+      V ti[3];
+      rotate(geo.R, tau, ti);
+      for (int a = 0; a < 3; ++a) simd::store(Fv[a] + cc, ti[a]);
+      simd::store(Fv[3] + cc, work + kf * gT[d]);
     };
-    auto axis_pass = [&]<int d>() {
-      const index_t s = grid.stride(d);
+    // Faces of row (j, k) along axis d (high cells i = 0 … n_x − 1, and n_x for x faces).
+    auto faces_row = [&]<int d>(index_t j, index_t k) {
       const double* idc = grid.inv_centre_gaps(d);
-      const double* inv_h = grid.inv_widths(d);
-      const index_t top[3] = {nx + (d == 0), ny + (d == 1), nz + (d == 2)};  // faces: high cells 0 … n_d
-      par_for(threaded, 0, top[2], [&](index_t k) {
-        for (index_t j = 0; j < top[1]; ++j)
-          for (index_t i = 0; i < top[0]; ++i) {
-            const index_t c = grid.index(i, j, k);
-            const index_t ijk[3] = {i, j, k};
-            face(d, c - s, c, idc[ijk[d]], c);
-          }
-      });
-      hook(d, Fv);
-      par_for(threaded, 0, nz, [&](index_t k) {
-        for (index_t j = 0; j < ny; ++j)
-          for (index_t i = 0; i < nx; ++i) {
-            const index_t c = grid.index(i, j, k);
-            const index_t ijk[3] = {i, j, k};
-            const double ih = inv_h[ijk[d]];
-            for (int q = 0; q < 4; ++q) {
-              if constexpr (d == 0) acc[q][c] = 0.0;
-              acc[q][c] += (Fv[q][c + s] - Fv[q][c]) * ih;
-            }
-          }
+      const index_t base = grid.index(0, j, k);
+      const double inv_y = d == 1 ? 0.0 : inv_gap(1, j), inv_z = d == 2 ? 0.0 : inv_gap(2, k);
+      lanes(0, nx + (d == 0), [&](auto tag, index_t i) {
+        using V = typename decltype(tag)::type;
+        const V id = d == 0 ? simd::load<V>(idc + i) : V(idc[d == 1 ? j : k]);
+        const V inv[3] = {d == 0 ? V(0.0) : inv_gap_x.template operator()<V>(i), V(inv_y), V(inv_z)};
+        face.template operator()<d, V>(base + i, id, inv);
       });
     };
-    axis_pass.template operator()<0>();
-    axis_pass.template operator()<1>();
-    axis_pass.template operator()<2>();
-    par_for(threaded, 0, nz, [&](index_t k) {
-      for (index_t j = 0; j < ny; ++j)
-        for (index_t i = 0; i < nx; ++i) {
-          const index_t c = grid.index(i, j, k);
-          dU[1][c] += acc[0][c];
-          dU[2][c] += acc[1][c];
-          dU[3][c] += acc[2][c];
-          dU[4][c] += acc[3][c];
+    // Differences across axis d of the cells of row (j, k) into acc; after z, into dU.
+    auto differences_row = [&]<int d>(index_t j, index_t k) {
+      const index_t s = sd[d];
+      const double* inv_h = grid.inv_widths(d);
+      const index_t base = grid.index(0, j, k);
+      lanes(0, nx, [&](auto tag, index_t i) {
+        using V = typename decltype(tag)::type;
+        const index_t c = base + i;
+        const V ih = d == 0 ? simd::load<V>(inv_h + i) : V(inv_h[d == 1 ? j : k]);
+        for (int q = 0; q < 4; ++q) {
+          const V a0 = d == 0 ? V(0.0) : simd::load<V>(acc[q] + c);
+          const V a = a0 + (simd::load<V>(Fv[q] + c + s) - simd::load<V>(Fv[q] + c)) * ih;
+          // 4. After the last axis, the sum into the rates.
+          if constexpr (d == 2) simd::store(dU[q + 1] + c, simd::load<V>(dU[q + 1] + c) + a);
+          else simd::store(acc[q] + c, a);
         }
+      });
+    };
+    // Each row's differences right after the faces they need (still in cache): x rows
+    // by themselves, y rows walking j in each plane k, z rows walking k for each j.
+    par_for(threaded, 0, nz, [&](index_t k) {
+      for (index_t j = 0; j < ny; ++j) {
+        faces_row.template operator()<0>(j, k);
+        differences_row.template operator()<0>(j, k);
+      }
     });
+    hook(0, Fv);
+    par_for(threaded, 0, nz, [&](index_t k) {
+      for (index_t j = 0; j <= ny; ++j) {
+        faces_row.template operator()<1>(j, k);
+        if (j > 0) differences_row.template operator()<1>(j - 1, k);
+      }
+    });
+    hook(1, Fv);
+    par_for(threaded, 0, ny, [&](index_t j) {
+      for (index_t k = 0; k <= nz; ++k) {
+        faces_row.template operator()<2>(j, k);
+        if (k > 0) differences_row.template operator()<2>(j, k - 1);
+      }
+    });
+    hook(2, Fv);
   }
 };
 

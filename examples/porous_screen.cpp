@@ -144,8 +144,7 @@ int main(int argc, char** argv) {
       };
       if (coupling == "embedded") {
         pf::coupling::embedded_options eo;
-        eo.law_on = through_flow == "face" ? pf::coupling::through_flow_law::face_velocity
-                                           : pf::coupling::through_flow_law::cloth_normal;
+        eo.law_on = pf::coupling::through_flow_law_named(through_flow);
         return run(pf::coupling::embedded{law, eo});
       }
       return run(pf::coupling::penalty{law, po});

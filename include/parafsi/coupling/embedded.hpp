@@ -104,6 +104,13 @@ inline const char* to_string(through_flow_law l) noexcept {
   return l == through_flow_law::face_velocity ? "face" : "cloth";
 }
 
+/// The law named "face" or "cloth" (the inverse of to_string; the programs' --through-flow).
+inline through_flow_law through_flow_law_named(const std::string& name) {
+  require(name == "face" || name == "cloth", "coupling::embedded: through-flow law must be face or cloth, got '", name,
+          "'");
+  return name == "face" ? through_flow_law::face_velocity : through_flow_law::cloth_normal;
+}
+
 struct embedded_options {
   double max_cells_per_step = 1.0;  ///< reject steps where the membrane moves farther (cells)
   /// The velocity the fabric law acts on: the cloth's normal (default) or the face's.
@@ -119,8 +126,6 @@ struct embedded_options {
             impedance);
     require(max_cells_per_step > 0 && std::isfinite(max_cells_per_step),
             "coupling::embedded: max_cells_per_step must be > 0, got ", max_cells_per_step);
-    require(law_on == through_flow_law::face_velocity || law_on == through_flow_law::cloth_normal,
-            "coupling::embedded: law_on must be face_velocity or cloth_normal");
     require(root_tolerance > 0 && root_tolerance < 1e-3,
             "coupling::embedded: root_tolerance must be in (0, 1e-3), got ", root_tolerance);
   }

@@ -43,9 +43,9 @@
 ///           the overshoot scan of t_mo (the diameter fallen back by the band below its
 ///           overshoot) if that sample lies before the last `window` seconds (where D_s is
 ///           averaged); the whole history when the canopy does not fall back, never reaches
-///           D_s, or the run is too short to have a steady window (a run of the opening alone). A later peak of the
-///           ringing in descent (a filtered 18.8 N at 5.7 s above the 18.2 N opening of the permeable mat509) is not
-///           the opening load.
+///           D_s, or the run is too short to have a steady window (a run of the opening
+///           alone). A later peak of the ringing in descent (a filtered 18.8 N at 5.7 s
+///           above the 18.2 N opening of the permeable mat509) is not the opening load.
 ///   v_terminal, cd_terminal  means of speed and drag_coefficient over the last `window` s
 ///   attitude_amplitude  peak canopy tilt from the vertical over the last `window` s, the
 ///           tilt of the axis with angles (φx, φy): atan(√(tan²φx + tan²φy))

@@ -793,8 +793,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
       if (c.coupling == "embedded") {
         coupling::embedded_options eo;
         eo.impedance = c.impedance;
-        eo.law_on = c.through_flow == "face" ? coupling::through_flow_law::face_velocity
-                                             : coupling::through_flow_law::cloth_normal;
+        eo.law_on = coupling::through_flow_law_named(c.through_flow);
         using C = coupling::embedded<porosity::ergun>;
         detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
         return run.run(progress);
@@ -818,8 +817,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
     if (c.coupling == "embedded") {
       coupling::embedded_options eo;
       eo.impedance = c.impedance;
-      eo.law_on = c.through_flow == "face" ? coupling::through_flow_law::face_velocity
-                                           : coupling::through_flow_law::cloth_normal;
+      eo.law_on = coupling::through_flow_law_named(c.through_flow);
       return go(coupling::embedded{law, eo});
     }
     coupling::penalty_options po;

@@ -2,8 +2,8 @@
 // hemispherical cup open towards it, held fixed (every node pinned) in air at U
 // (default 40 m/s, Mach 0.12: low Mach, and half the acoustic steps of 20 m/s), run for
 // --flow-times D/U (default 16). Prints `drag_coefficient=<Cd>`, the time-weighted mean
-// over the second half of the run (t > t_end/2), and writes the CSV `t,drag_coefficient`
-// (one row per fluid step). Default run (--cells 8): about a minute on one core.
+// over the second half of the run (t > t_end/2), and writes the CSV
+// `t,drag_coefficient,side_force_y,side_force_z` (one row per fluid step). Default run (--cells 8): about a minute on one core.
 //
 // Drag = the force the coupling exerts on the body along the stream: the coupling's
 // structure impulse of each step, Σ_nodes F·x̂ Δt̄ (pinned nodes included), divided by
@@ -25,10 +25,25 @@
 // Δp = K ½ρ u_n|u_n| (Ergun with α = 0, β t = K ρ / 2), u_n the through-velocity normal to
 // the cloth. Then `through_fraction=` is also printed: the mean through-velocity over the
 // body (the coupling's through-flow / its area) over U, averaged like the drag.
+//
+// Wake: `--closure mixing_length|smagorinsky` adds that eddy viscosity to the air's
+// (μ = 1.79e-5 Pa s unless --reynolds sets it; mixing length l_m = min(κ d_w, 0.07 D, Δ),
+// d_w from the body's nodes; Smagorinsky C_s = 0.1; μ_t ≤ 1000 μ, as the drop scene).
+// `--kick F` starts the air with a transverse velocity F·U along y (the far field then
+// washes it out), breaking the set-up's symmetry so that a wake that can shed does. The CSV
+// also has the side-force coefficients (y, z, over ½ρU²A; zero on the flat disk, whose
+// inviscid load is normal to it) and the transverse velocity (v, w)/U of a wake probe on
+// the axis 2D behind the rim plane (a hot wire's place). The program prints `strouhal=`
+// f D/U of the probe's dominant frequency over the second half (io/spectrum.hpp: the
+// summed spectrum of v and w, St in [0.02, 2]), `probe_amplitude=` its amplitude (/U) and
+// `shedding_periods=` the periods the second half holds; `strouhal=none` when the probe's
+// transverse velocity stays below 1e-3 U (a steady wake).
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
+#include <parafsi/fluid/wall_distance.hpp>
+#include <parafsi/io/spectrum.hpp>
 #include <parafsi/model/disk_mesh.hpp>
 #include <parafsi/model/fabric_catalogue.hpp>
 
@@ -40,8 +55,8 @@ namespace st = pf::structure;
 int main(int argc, char** argv) {
   CLI::App app{"Drag of a fixed disk or hemispherical cup in a uniform stream (penalty or embedded coupling)"};
   examples::common_options co;
-  std::string shape = "disk", coupling = "embedded", out, fabric = "none";
-  double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0;
+  std::string shape = "disk", coupling = "embedded", out, fabric = "none", closure = "none";
+  double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0, kick = 0.0;
   int cells = 8;
   examples::add_run_options(app, co);
   app.add_option("--shape", shape, "disk (flat, normal to the stream) or cup (hemisphere, open towards the stream)")
@@ -70,6 +85,15 @@ int main(int argc, char** argv) {
       ->check(examples::finite)
       ->check(CLI::Range(0.0, 1e6))
       ->excludes(fab_opt)
+      ->capture_default_str();
+  app.add_option("--closure", closure,
+                 "eddy-viscosity closure of the wake: none, mixing_length (Prandtl's, distance to the body) or "
+                 "smagorinsky; with a closure the air has its viscosity (1.79e-5 Pa s unless --reynolds)")
+      ->check(CLI::IsMember({"none", "mixing_length", "smagorinsky"}))
+      ->capture_default_str();
+  app.add_option("--kick", kick, "initial transverse velocity along y as a fraction of U (breaks the symmetry)")
+      ->check(examples::finite)
+      ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")
       ->check(CLI::Range(1e-4, 1e3))
@@ -114,19 +138,35 @@ int main(int argc, char** argv) {
     st::membrane_tri mem{tm, st::material::fabric<>::isotropic(3e8, 0.3, 0.054, 1.1e-4)};
     st::assembly as{std::move(nd), std::move(mem)};
     as.integrator().gravity = {0, 0, 0};
+    const double mu = Re > 0 ? rho * U * D / Re : (closure != "none" ? 1.79e-5 : 0.0);
     if (!co.quiet)
       std::fprintf(stderr,
                    "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, grid %lld x %lld x %lld = %lld "
                    "cells, %zu triangles, t_end = %g s (%g D/U), %s\n",
                    shape.c_str(), coupling.c_str(), D, U, cells, (long long)grid.n(0), (long long)grid.n(1),
                    (long long)grid.n(2), (long long)grid.interior_cells(), dm.triangles.size(), t_end, t_end * U / D,
-                   Re > 0 ? ("Re = " + std::to_string(Re)).c_str() : "inviscid");
+                   mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str()
+                          : "inviscid");
 
+    // Wake probe: the cell holding (2D, 0, 0).
+    std::array<pf::index_t, 3> probe{};
+    for (int d = 0; d < 3; ++d) {
+      const auto& f = grid.axis_of(d).faces;
+      probe[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), d == 0 ? 2 * D : 0.0) - f.begin()) - 1;
+    }
     auto run_with = [&](auto fl) -> int {
-      fl.fill_uniform({rho, {U, 0, 0}, p0});
+      fl.fill_uniform({rho, {U, kick * U, 0}, p0});
+      if constexpr (decltype(fl)::needs_wall_distance) {
+        std::vector<Eigen::Vector3d> pts(std::size_t(as.node_set().size()));
+        for (pf::index_t i = 0; i < as.node_set().size(); ++i) pts[std::size_t(i)] = as.node_set().position(i);
+        const auto& ml = fl.turbulence();
+        pf::fluid::distance_to_points(fl.grid(), pts, ml.c_l * ml.ref_length / ml.kappa,
+                                      std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())));
+      }
       auto run = [&](auto cpl) -> int {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
-        examples::csv_writer csv(out, "t,drag_coefficient");
+        examples::csv_writer csv(out, "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w");
+        std::vector<double> ts, pv, pw;  // the second half, for the probe's spectrum
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
         double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0;
         examples::step_guard guard("bluff_body_drag", t_end);
@@ -138,9 +178,16 @@ int main(int argc, char** argv) {
           const double t0 = s.time();
           s.step(dt);
           max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
-          const double cd = s.coupling().diagnostics().impulse_structure.x() / dt / qA;
-          if (!std::isfinite(cd)) throw pf::numerical_failure("bluff_body_drag: drag is not finite", 0, s.time());
-          csv.row({s.time(), cd});
+          const Eigen::Vector3d c = s.coupling().diagnostics().impulse_structure / dt / qA;
+          const double cd = c.x();
+          if (!c.allFinite()) throw pf::numerical_failure("bluff_body_drag: the body force is not finite", 0, s.time());
+          const auto wp = s.fluid().primitive(probe[0], probe[1], probe[2]);
+          csv.row({s.time(), cd, c.y(), c.z(), wp.u.y / U, wp.u.z / U});
+          if (s.time() > t_avg) {
+            ts.push_back(s.time());
+            pv.push_back(wp.u.y / U);
+            pw.push_back(wp.u.z / U);
+          }
           // Time-weighted mean over the part of the step inside [t_avg, t_end].
           const double w = s.time() - std::max(t0, t_avg);
           if (w > 0) {
@@ -160,7 +207,16 @@ int main(int argc, char** argv) {
             cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
         if constexpr (decltype(cpl)::porosity_type::permeable)
           std::printf(" through_fraction=%.6g", sum_t > 0 ? sum_q / sum_t : 0.0);
-        std::printf("\n");
+        // The wake probe: its dominant frequency in St ∈ [0.02, 2] over the second half.
+        if (ts.size() >= 8 && (ts.back() - ts.front()) * U / D > 1.0) {
+          const auto pk = pf::io::dominant_frequency(ts, {pv, pw}, 0.02 * U / D, 2.0 * U / D);
+          if (pk.amplitude >= 1e-3)
+            std::printf(" strouhal=%.4g probe_amplitude=%.3g shedding_periods=%.3g", pk.frequency * D / U,
+                        pk.amplitude, pk.periods);
+          else
+            std::printf(" strouhal=none probe_amplitude=%.3g", pk.amplitude);
+        }
+        std::printf(" closure=%s reynolds=%.4g\n", closure.c_str(), mu > 0 ? rho * U * D / mu : 0.0);
         return 0;
       };
       auto with = [&](auto por) -> int {
@@ -179,11 +235,22 @@ int main(int argc, char** argv) {
       }
       return with(pf::porosity::impermeable{});
     };
-    if (Re > 0) {
-      const double mu = rho * U * D / Re;
-      return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{},
-                                        pf::viscosity::constant{mu, 0.72}});
+    using muscl = pf::recon::muscl<pf::limiter::van_leer>;
+    if (closure == "mixing_length") {
+      pf::turbulence::prandtl_mixing_length ml;
+      ml.ref_length = D;
+      ml.mu_cap = 1000.0 * mu;
+      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::prandtl_mixing_length,
+                                        pf::viscosity::constant>{grid, bc, ml, pf::viscosity::constant{mu, 0.72}});
     }
-    return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, pf::recon::muscl<pf::limiter::van_leer>{}});
+    if (closure == "smagorinsky") {
+      pf::turbulence::smagorinsky sm;
+      sm.mu_cap = 1000.0 * mu;
+      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::smagorinsky,
+                                        pf::viscosity::constant>{grid, bc, sm, pf::viscosity::constant{mu, 0.72}});
+    }
+    if (mu > 0)
+      return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, muscl{}, pf::viscosity::constant{mu, 0.72}});
+    return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, muscl{}});
   });
 }

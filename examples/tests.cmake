@@ -182,7 +182,7 @@ parafsi_example_dir_test(example_parachute_drop_tiny_pgs parachute_drop "history
 # The method's mixing-length closure (distance to the canopy and lines refreshed every step).
 parafsi_example_dir_test(example_parachute_drop_tiny_mixing_length parachute_drop "summary.csv"
   "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
-  "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --turbulence mixing_length --quiet)
+  "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --closure mixing_length --quiet)
 # The block mesh (penalty coupling): the tiny scene for 20 ms, history, summary, a slice, VTK.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "history.csv|summary.csv|slice_00.010.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"

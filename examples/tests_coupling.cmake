@@ -89,11 +89,20 @@ parafsi_coupling_example_fails(example_coupling_leak_box_bad_jump leak_box --pre
 # ---- bluff_body_drag (when built).
 if(TARGET bluff_body_drag)
   foreach(shape IN ITEMS disk cup)
-    parafsi_coupling_example(example_coupling_bluff_${shape} bluff_body_drag "t,drag_coefficient"
+    parafsi_coupling_example(example_coupling_bluff_${shape} bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
       "drag_coefficient=[0-9.e+-]+ " --shape ${shape} --coupling embedded --cells 4 --time 0.002 --quiet)
   endforeach()
-  parafsi_coupling_example(example_coupling_bluff_disk_penalty bluff_body_drag "t,drag_coefficient"
+  parafsi_coupling_example(example_coupling_bluff_disk_penalty bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ " --shape disk --coupling penalty --cells 4 --time 0.002 --quiet)
+  # The wake closures and the symmetry kick: the wake probe's spectrum is printed.
+  foreach(closure IN ITEMS mixing_length smagorinsky)
+    parafsi_coupling_example(example_coupling_bluff_disk_${closure} bluff_body_drag
+      "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
+      "drag_coefficient=[0-9.e+-]+ .* strouhal=[0-9.e+-]+ probe_amplitude=[0-9.e+-]+ .*closure=${closure} reynolds=5.27"
+      --shape disk --cells 4 --time 0.03 --kick 0.05 --closure ${closure} --quiet)
+  endforeach()
+  parafsi_coupling_example_fails(example_coupling_bluff_bad_closure bluff_body_drag --closure k_epsilon
+    --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_bad_shape bluff_body_drag --shape sphere
     --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_bad_coupling bluff_body_drag --coupling foo

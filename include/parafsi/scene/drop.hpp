@@ -150,7 +150,7 @@ struct drop_config {
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
     require(one_of(turbulence, {"none", "mixing_length", "smagorinsky"}),
             "parachute_drop: turbulence must be none, mixing_length or smagorinsky, got '", turbulence, "'");
-    require(turbulence == "none" || viscosity != "inviscid", "parachute_drop: --turbulence ", turbulence,
+    require(turbulence == "none" || viscosity != "inviscid", "parachute_drop: --closure ", turbulence,
             " is an eddy viscosity added to the air's: it cannot run with --viscosity inviscid");
     require(one_of(packed, {"scene", "reduced_radius", "star_fold", "bundle", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");

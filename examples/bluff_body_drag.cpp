@@ -3,7 +3,8 @@
 // (default 40 m/s, Mach 0.12: low Mach, and half the acoustic steps of 20 m/s), run for
 // --flow-times D/U (default 16). Prints `drag_coefficient=<Cd>`, the time-weighted mean
 // over the second half of the run (t > t_end/2), and writes the CSV
-// `t,drag_coefficient,side_force_y,side_force_z` (one row per fluid step). Default run (--cells 8): about a minute on one core.
+// `t,drag_coefficient,side_force_y,side_force_z` (one row per fluid step). Default run (--cells 8): about a minute on
+// one core.
 //
 // Drag = the force the coupling exerts on the body along the stream: the coupling's
 // structure impulse of each step, Σ_nodes F·x̂ Δt̄ (pinned nodes included), divided by
@@ -145,8 +146,7 @@ int main(int argc, char** argv) {
                    "cells, %zu triangles, t_end = %g s (%g D/U), %s\n",
                    shape.c_str(), coupling.c_str(), D, U, cells, (long long)grid.n(0), (long long)grid.n(1),
                    (long long)grid.n(2), (long long)grid.interior_cells(), dm.triangles.size(), t_end, t_end * U / D,
-                   mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str()
-                          : "inviscid");
+                   mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str() : "inviscid");
 
     // Wake probe: the cell holding (2D, 0, 0).
     std::array<pf::index_t, 3> probe{};
@@ -211,10 +211,9 @@ int main(int argc, char** argv) {
         if (ts.size() >= 8 && (ts.back() - ts.front()) * U / D > 1.0) {
           const auto pk = pf::io::dominant_frequency(ts, {pv, pw}, 0.02 * U / D, 2.0 * U / D);
           if (pk.amplitude >= 1e-3)
-            std::printf(" strouhal=%.4g probe_amplitude=%.3g shedding_periods=%.3g", pk.frequency * D / U,
-                        pk.amplitude, pk.periods);
-          else
-            std::printf(" strouhal=none probe_amplitude=%.3g", pk.amplitude);
+            std::printf(" strouhal=%.4g probe_amplitude=%.3g shedding_periods=%.3g", pk.frequency * D / U, pk.amplitude,
+                        pk.periods);
+          else std::printf(" strouhal=none probe_amplitude=%.3g", pk.amplitude);
         }
         std::printf(" closure=%s reynolds=%.4g\n", closure.c_str(), mu > 0 ? rho * U * D / mu : 0.0);
         return 0;
@@ -240,14 +239,15 @@ int main(int argc, char** argv) {
       pf::turbulence::prandtl_mixing_length ml;
       ml.ref_length = D;
       ml.mu_cap = 1000.0 * mu;
-      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::prandtl_mixing_length,
-                                        pf::viscosity::constant>{grid, bc, ml, pf::viscosity::constant{mu, 0.72}});
+      return run_with(
+          pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::prandtl_mixing_length, pf::viscosity::constant>{
+              grid, bc, ml, pf::viscosity::constant{mu, 0.72}});
     }
     if (closure == "smagorinsky") {
       pf::turbulence::smagorinsky sm;
       sm.mu_cap = 1000.0 * mu;
-      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::smagorinsky,
-                                        pf::viscosity::constant>{grid, bc, sm, pf::viscosity::constant{mu, 0.72}});
+      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::smagorinsky, pf::viscosity::constant>{
+          grid, bc, sm, pf::viscosity::constant{mu, 0.72}});
     }
     if (mu > 0)
       return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, muscl{}, pf::viscosity::constant{mu, 0.72}});

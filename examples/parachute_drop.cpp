@@ -201,9 +201,10 @@ int main(int argc, char** argv) {
          "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
-  app.add_option("--closure,--turbulence", c.turbulence,
-                 "eddy-viscosity closure of the wake, added to the air's viscosity: none, mixing_length (Prandtl's, the "
-                 "method's; distance to the canopy and lines) or smagorinsky (--turbulence: the same)")
+  app.add_option(
+         "--closure,--turbulence", c.turbulence,
+         "eddy-viscosity closure of the wake, added to the air's viscosity: none, mixing_length (Prandtl's, the "
+         "method's; distance to the canopy and lines) or smagorinsky (--turbulence: the same)")
       ->check(CLI::IsMember({"none", "mixing_length", "smagorinsky"}))
       ->capture_default_str();
   app.add_option("--impedance", c.impedance,

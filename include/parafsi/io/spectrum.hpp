@@ -45,8 +45,8 @@ struct spectral_peak {
 };
 
 struct spectrum_options {
-  int pad = 8;                    ///< frequency grid spacing 1/(pad T)
-  std::size_t max_samples = 8192; ///< uniform resampling points N (fewer if the record has fewer)
+  int pad = 8;                     ///< frequency grid spacing 1/(pad T)
+  std::size_t max_samples = 8192;  ///< uniform resampling points N (fewer if the record has fewer)
 };
 
 /// Dominant frequency in [f_min, f_max] of the signals `xs` (each as long as `t`); rules above.
@@ -54,8 +54,8 @@ inline spectral_peak dominant_frequency(std::span<const double> t, std::initiali
                                         double f_min, double f_max, const spectrum_options& o = {}) {
   const std::size_t m = t.size();
   require(m >= 8, "io::dominant_frequency: needs at least 8 samples, got ", m);
-  require(f_min >= 0 && f_max > f_min && std::isfinite(f_max), "io::dominant_frequency: bad band [", f_min, ", ",
-          f_max, "]");
+  require(f_min >= 0 && f_max > f_min && std::isfinite(f_max), "io::dominant_frequency: bad band [", f_min, ", ", f_max,
+          "]");
   require(o.pad >= 1 && o.max_samples >= 8, "io::dominant_frequency: pad >= 1 and max_samples >= 8");
   for (std::size_t i = 1; i < m; ++i)
     require(t[i] > t[i - 1], "io::dominant_frequency: times must increase (sample ", i, ")");

@@ -183,6 +183,10 @@ parafsi_example_dir_test(example_parachute_drop_tiny_pgs parachute_drop "history
 parafsi_example_dir_test(example_parachute_drop_tiny_mixing_length parachute_drop "summary.csv"
   "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --closure mixing_length --quiet)
+# The embedded coupling with first-order cells beside the cloth (the default is one-sided on the box).
+parafsi_example_dir_test(example_parachute_drop_tiny_first_order parachute_drop "summary.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
+  "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --membrane-reconstruction first_order --quiet)
 # The block mesh (penalty coupling): the tiny scene for 20 ms, history, summary, a slice, VTK.
 parafsi_example_dir_test(example_parachute_drop_tiny_blocks parachute_drop "history.csv|summary.csv|slice_00.010.csv"
   "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered|fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|xi,zeta,x,y,z,rho,p,speed,speed_rel,omega_n"
@@ -333,6 +337,8 @@ parafsi_example_refuses(example_drop_guide_history_full drop_guide "history.csv"
 # structure::relax's step limit, tests/test_structure_cable.cpp; examples::step_guard).
 parafsi_example_refuses(example_hanging_chain_huge_EA hanging_chain "" "--EA: Value 1e300 not in range"
   --links 8 --length 1.2 --span 1 --EA 1e300 --out ${_ex_out}/unused_chain.csv)
+parafsi_example_refuses(example_parachute_drop_blocks_one_sided parachute_drop ""
+  "one_sided is not available on the block mesh" --mesh blocks --membrane-reconstruction one_sided --t-end 0.01)
 parafsi_example_refuses(example_bluff_body_drag_tiny_reynolds bluff_body_drag ""
   "--reynolds: Reynolds number 1e-300 is neither 0" --reynolds 1e-300 --out ${_ex_out}/unused_bluff.csv)
 

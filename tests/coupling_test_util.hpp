@@ -29,17 +29,22 @@ struct penalty {
   }
 };
 
-/// Coupling list entry: the embedded coupling with its default options (it has no PFAC).
-struct embedded {
-  static constexpr const char* name = "embedded";
+/// Coupling list entry: the embedded coupling with its default options (it has no PFAC),
+/// the cells beside the membrane first order (OneSided = false, the class's default) or
+/// reconstructed from their own side (OneSided = true, the drop's default on the box).
+template <bool OneSided>
+struct embedded_t {
+  static constexpr const char* name = OneSided ? "embedded/one-sided" : "embedded";
   template <class Porosity>
   static auto make(Porosity por, double /*pfac*/) {
-    return pf::coupling::embedded{por};
+    return pf::coupling::embedded<Porosity, OneSided>{por};
   }
 };
+using embedded = embedded_t<false>;
+using embedded_one_sided = embedded_t<true>;
 
 /// The coupling list: TEST_CASE_TEMPLATE_DEFINE(name, C, id) then TEST_CASE_TEMPLATE_APPLY(id, ctu::couplings).
-using couplings = std::tuple<penalty, embedded>;
+using couplings = std::tuple<penalty, embedded, embedded_one_sided>;
 
 /// A tilted 0.18 × 0.17 m square patch (3 × 3 quads, isotropic fabric of modulus E and areal
 /// density ρ_A, thickness 0.1 mm) moving at v0 through still air of density rho in a periodic

@@ -51,8 +51,8 @@ struct balance<ctu::penalty> {
   }
 };
 
-template <>
-struct balance<ctu::embedded> {
+template <bool OS>
+struct balance<ctu::embedded_t<OS>> {
   static constexpr double rho = 1.2;
   static constexpr double pfac_impermeable = 0, pfac_porous = 0;
   struct extra {

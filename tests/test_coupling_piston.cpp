@@ -122,8 +122,8 @@ struct piston<ctu::penalty> {
   }
 };
 
-template <>
-struct piston<ctu::embedded> {
+template <bool OS>
+struct piston<ctu::embedded_t<OS>> {
   struct run {
     double v, pfac;
     int cells;
@@ -134,12 +134,16 @@ struct piston<ctu::embedded> {
     const double cs = std::sqrt(1.4 * p0 / rho0);
     const double e_v = r.rise / (rho0 * cs * c.v) - 1.0, e_exact = r.rise / exact_piston_rise(c.v) - 1.0;
     std::printf(
-        "embedded piston v %-4g cells %-3d: dp = %.2f Pa, rho c v = %.2f Pa (%+.3f %%), exact shock %.2f Pa "
+        "%s piston v %-4g cells %-3d: dp = %.2f Pa, rho c v = %.2f Pa (%+.3f %%), exact shock %.2f Pa "
         "(%+.3f %%), u_air = %.5f m/s\n",
-        c.v, c.cells, r.rise, rho0 * cs * c.v, 100 * e_v, exact_piston_rise(c.v), 100 * e_exact, r.u_air);
+        ctu::embedded_t<OS>::name, c.v, c.cells, r.rise, rho0 * cs * c.v, 100 * e_v, exact_piston_rise(c.v),
+        100 * e_exact, r.u_air);
     CHECK(std::fabs(e_exact) < 0.005);
     if (c.v <= 2.0) CHECK(std::fabs(e_v) < 0.02);  // the bound (the shock adds 0.35 % at 2 m/s)
-    CHECK(std::fabs(r.u_air - c.v) < 1e-3 * c.v);  // the air moves with the plate: no leak
+    // The air moves with the plate: no leak (window mean between plate and shock; measured
+    // +0.008 % first order and +0.12 % one-sided at 50 cells, both < 0.03 % at 200; the
+    // penalty plate's leak is several per cent).
+    CHECK(std::fabs(r.u_air - c.v) < 3e-3 * c.v);
   }
 };
 }  // namespace

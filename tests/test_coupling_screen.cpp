@@ -111,16 +111,18 @@ struct screen<ctu::penalty> {
 template <class Leak>
 double leak_of(Leak cpl, int cells);
 
-template <>
-struct screen<ctu::embedded> {
+template <bool OS>
+struct screen<ctu::embedded_t<OS>> {
   struct tally {
     double worst_lm = 0, worst_hllc = 0, dp_min = 1e300, dp_max = 0;
   };
   static void run_fabric(tally& t, std::size_t fi, const pf::porosity::ergun& law, const char* name) {
     for (double V : V_in[fi]) {
       double dp = 0;
-      const double e_lm = screen_error(ctu::embedded::make(law, 0), law, V, pf::flux::hllc_lm{}, "embedded", name, &dp);
-      const double e_h = screen_error(ctu::embedded::make(law, 0), law, V, pf::flux::hllc{}, "embedded", name);
+      const double e_lm = screen_error(ctu::embedded_t<OS>::make(law, 0), law, V, pf::flux::hllc_lm{},
+                                       ctu::embedded_t<OS>::name, name, &dp);
+      const double e_h = screen_error(ctu::embedded_t<OS>::make(law, 0), law, V, pf::flux::hllc{},
+                                      ctu::embedded_t<OS>::name, name);
       CHECK(std::fabs(e_lm) < 0.10);
       CHECK(std::fabs(e_h) < 1e-2);
       t.worst_lm = std::max(t.worst_lm, std::fabs(e_lm));
@@ -130,8 +132,8 @@ struct screen<ctu::embedded> {
     }
   }
   static void finish(const tally& t) {
-    std::printf("porous screen over %.1f-%.1f Pa: worst |error| embedded/hllc_lm %.2f %%, embedded/hllc %.4f %%\n",
-                t.dp_min, t.dp_max, 100 * t.worst_lm, 100 * t.worst_hllc);
+    std::printf("porous screen over %.1f-%.1f Pa: worst |error| %s/hllc_lm %.2f %%, %s/hllc %.4f %%\n", t.dp_min,
+                t.dp_max, ctu::embedded_t<OS>::name, 100 * t.worst_lm, ctu::embedded_t<OS>::name, 100 * t.worst_hllc);
     CHECK(t.dp_min < 22.0);
     CHECK(t.dp_min > 15.0);
     CHECK(t.dp_max > 450.0);
@@ -145,9 +147,9 @@ struct screen<ctu::embedded> {
   static void check_leak(double leak, double u544, int cells) {
     const double lp = leak_of(ctu::penalty::make(pf::porosity::impermeable{}, 1.0), cells);
     std::printf(
-        "leak box %d cells: embedded leak %.3e m/s (%.4f %% of mat544's %.4f m/s), penalty (PFAC 1) leak "
+        "leak box %d cells: %s leak %.3e m/s (%.4f %% of mat544's %.4f m/s), penalty (PFAC 1) leak "
         "%.3e m/s (%.1f %%)\n",
-        cells, leak, 100 * std::fabs(leak) / u544, u544, lp, 100 * lp / u544);
+        cells, ctu::embedded_t<OS>::name, leak, 100 * std::fabs(leak) / u544, u544, lp, 100 * lp / u544);
     CHECK(std::fabs(leak) < 0.1 * u544);
     CHECK(std::fabs(leak) < 1e-12);
     CHECK(lp > std::fabs(leak));

@@ -183,6 +183,7 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
           {"pgs_alpha", [](cfg& c) { c.pgs_alpha = 6; }},
           {"impedance", [](cfg& c) { c.impedance = 0.5; }},
           {"through_flow", [](cfg& c) { c.through_flow = "face"; }},
+          {"membrane_reconstruction", [](cfg& c) { c.membrane_reconstruction = "first_order"; }},
           {"pfac", [](cfg& c) { c.pfac = 2; }},
           {"stiffening", [](cfg& c) { c.stiffening = 0.5; }},
           {"coupling_damping", [](cfg& c) { c.coupling_damping = 0.1; }},

@@ -150,8 +150,10 @@ struct embedded_diagnostics {
 };
 
 /// `OneSided`: reconstruct the cells beside a membrane face from their own side (second
-/// order up to the membrane; see `one_sided_reconstruction`). Off by default: on a curved,
-/// flexible porous sheet it removes the damping that lets the sheet settle (docs/coupling.md).
+/// order up to the membrane; see `one_sided_reconstruction`; docs/coupling.md §7: an acoustic
+/// pulse reflects to order 2.2 instead of 1.3, a flexible porous sheet settles as with
+/// first-order states). Off by default because the block solver does not have it; the drop
+/// scene turns it on on the box solver.
 template <class Porosity = porosity::impermeable, bool OneSided = false>
 class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, Porosity, embedded_options> {
   using base = detail::membrane_coupling<embedded<Porosity, OneSided>, Porosity, embedded_options>;

@@ -27,7 +27,10 @@
 /// SSP-RK2; constant μ or inviscid (`viscosity`). Pressure-gradient scaling α (`pgs_alpha`;
 /// 0 = auto: 8 with the embedded coupling, 1 with penalty, whose spring stiffness γp/α²
 /// it would soften): the air held at p/α². Coupling: embedded (default) or penalty (PFAC,
-/// stiffening λ), both with the fabric's Ergun law.
+/// stiffening λ), both with the fabric's Ergun law. The embedded coupling on the tensor box
+/// reconstructs the cells beside the cloth from their own side (`membrane_reconstruction`
+/// auto or one_sided: coupling::embedded<P, true>, second order up to the membrane); on the
+/// block mesh they are first order (one-sided is not available there).
 ///
 /// Loop (each step): the stable step at `cfl`, shortened to land on the next output
 /// instant n · history_every (an integer n, so a restarted run takes the steps of the
@@ -117,6 +120,13 @@ struct drop_config {
   /// embedded: the velocity the fabric law acts on, cloth (the cloth's normal) or face
   /// (each grid face's own, the rule before 2026-12; coupling::through_flow_law)
   std::string through_flow = "cloth";
+  /// embedded: the cells beside the cloth reconstructed from their own side (one_sided) or
+  /// first order (first_order); auto = one_sided on the tensor box, first_order on blocks
+  std::string membrane_reconstruction = "auto";
+  /// Whether the run's embedded coupling reconstructs the cells beside the cloth one-sided.
+  bool one_sided() const {
+    return coupling == "embedded" && mesh == "tensor" && membrane_reconstruction != "first_order";
+  }
   double pgs_alpha = 0.0;        ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
   double cell = 0, element = 0;  ///< overrides of the resolution (/ D0), 0 = the resolution's
   double initial_speed = -1;     ///< override of the scene's release speed (m/s), < 0 = scene
@@ -146,6 +156,12 @@ struct drop_config {
             coupling, "'");
     require(one_of(through_flow, {"cloth", "face"}), "parachute_drop: through-flow must be cloth or face, got '",
             through_flow, "'");
+    require(one_of(membrane_reconstruction, {"auto", "one_sided", "first_order"}),
+            "parachute_drop: membrane reconstruction must be auto, one_sided or first_order, got '",
+            membrane_reconstruction, "'");
+    require(!(mesh == "blocks" && membrane_reconstruction == "one_sided"),
+            "parachute_drop: --membrane-reconstruction one_sided is not available on the block mesh (its cells "
+            "beside the cloth are first order); use auto or first_order with --mesh blocks");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
     require(one_of(turbulence, {"none", "mixing_length", "smagorinsky"}),
@@ -341,6 +357,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
   if (c.turbulence != "none") g.add("turbulence", c.turbulence);
   g.add("through_flow", c.through_flow);
+  g.add("membrane_reconstruction", c.coupling != "embedded" ? "none" : (c.one_sided() ? "one_sided" : "first_order"));
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
@@ -818,6 +835,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
       coupling::embedded_options eo;
       eo.impedance = c.impedance;
       eo.law_on = coupling::through_flow_law_named(c.through_flow);
+      if (c.one_sided()) return go(coupling::embedded<porosity::ergun, true>{law, eo});
       return go(coupling::embedded{law, eo});
     }
     coupling::penalty_options po;

@@ -37,8 +37,9 @@
 // the axis 2D behind the rim plane (a hot wire's place). The program prints `strouhal=`
 // f D/U of the probe's dominant frequency over the second half (io/spectrum.hpp: the
 // summed spectrum of v and w, St in [0.02, 2]), `probe_amplitude=` its amplitude (/U) and
-// `shedding_periods=` the periods the second half holds; `strouhal=none` when the probe's
-// transverse velocity stays below 1e-3 U (a steady wake).
+// `shedding_periods=` the periods of that frequency the second half holds; `strouhal=none`
+// when the probe's amplitude is below 0.01 U (a steady wake) or the record holds fewer than
+// three periods (a drift, not a measurement).
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
@@ -210,10 +211,9 @@ int main(int argc, char** argv) {
         // The wake probe: its dominant frequency in St ∈ [0.02, 2] over the second half.
         if (ts.size() >= 8 && (ts.back() - ts.front()) * U / D > 1.0) {
           const auto pk = pf::io::dominant_frequency(ts, {pv, pw}, 0.02 * U / D, 2.0 * U / D);
-          if (pk.amplitude >= 1e-3)
-            std::printf(" strouhal=%.4g probe_amplitude=%.3g shedding_periods=%.3g", pk.frequency * D / U, pk.amplitude,
-                        pk.periods);
-          else std::printf(" strouhal=none probe_amplitude=%.3g", pk.amplitude);
+          if (pk.amplitude >= 1e-2 && pk.periods >= 3) std::printf(" strouhal=%.4g", pk.frequency * D / U);
+          else std::printf(" strouhal=none");
+          std::printf(" probe_amplitude=%.3g shedding_periods=%.3g", pk.amplitude, pk.periods);
         }
         std::printf(" closure=%s reynolds=%.4g\n", closure.c_str(), mu > 0 ? rho * U * D / mu : 0.0);
         return 0;

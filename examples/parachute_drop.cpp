@@ -12,9 +12,9 @@
 // frame::follow_payload translates it with the payload mass centre and turns its −z axis
 // to the payload velocity, tracked every step. Far field + sponge on all six faces; cells
 // refined around the canopy (fluid cell = 2 × canopy element size there), growing by
-// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, constant viscosity (inviscid at
-// draft/coarse), pressure-gradient scaling α = 8 with embedded, 1 with penalty (--pgs); embedded coupling with the
-// fabric's Ergun law on the cloth's normal through-velocity (--through-flow) and its
+// --growth outwards. HLLC-LM + MUSCL (van Leer), SSP-RK2, the air's viscosity with Prandtl's
+// mixing-length closure in the wake (--closure), pressure-gradient scaling α = 8 with embedded, 1 with penalty (--pgs);
+// embedded coupling with the fabric's Ergun law on the cloth's normal through-velocity (--through-flow) and its
 // impedance stabilisation, or the paper's penalty coupling
 // (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
@@ -196,16 +196,17 @@ int main(int argc, char** argv) {
                  "(with --packed bundle: the speed at line stretch); default: the scene's")
       ->check(finite)
       ->check(CLI::Range(0.0, 200.0));
-  app.add_option(
-         "--viscosity", c.viscosity,
-         "air viscosity: constant (mu of the scene), inviscid, or auto (inviscid at draft/coarse, else constant)")
+  app.add_option("--viscosity", c.viscosity,
+                 "air viscosity: constant (mu of the scene), inviscid, or auto (constant with a closure; without one "
+                 "inviscid at draft/coarse, else constant)")
       ->check(CLI::IsMember({"auto", "constant", "inviscid"}))
       ->capture_default_str();
   app.add_option(
          "--closure,--turbulence", c.turbulence,
-         "eddy-viscosity closure of the wake, added to the air's viscosity: none, mixing_length (Prandtl's, the "
-         "method's; distance to the canopy and lines) or smagorinsky (--turbulence: the same)")
-      ->check(CLI::IsMember({"none", "mixing_length", "smagorinsky"}))
+         "eddy-viscosity closure of the wake, added to the air's viscosity: mixing_length (Prandtl's, the method's; "
+         "distance to the canopy and lines), smagorinsky, none (the scheme's implicit LES) or auto (mixing_length; "
+         "none with --viscosity inviscid); --turbulence: the same")
+      ->check(CLI::IsMember({"auto", "none", "mixing_length", "smagorinsky"}))
       ->capture_default_str();
   app.add_option("--impedance", c.impedance,
                  "embedded: impedance (added-mass) stabilisation factor, 0 = off (light fabric is unstable without)")

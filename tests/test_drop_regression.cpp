@@ -23,6 +23,7 @@ TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
   parafsi::scene::drop_config c;
   c.resolution = "tiny";
   c.coupling = "penalty";  // the configuration the stored values were recorded with
+  c.turbulence = "none";
   c.pgs_alpha = 1.0;
   c.t_end = 0.25;
   c.initial_speed = 8.0;
@@ -187,7 +188,8 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
           {"pfac", [](cfg& c) { c.pfac = 2; }},
           {"stiffening", [](cfg& c) { c.stiffening = 0.5; }},
           {"coupling_damping", [](cfg& c) { c.coupling_damping = 0.1; }},
-          {"viscosity", [](cfg& c) { c.viscosity = "constant"; }},
+          {"viscosity", [](cfg& c) { c.viscosity = "inviscid"; }},
+          {"turbulence", [](cfg& c) { c.turbulence = "smagorinsky"; }},
           {"cfl", [](cfg& c) { c.cfl = 0.5; }},
           {"membrane_damping", [](cfg& c) { c.membrane_damping = 0.1; }},
           {"history_every", [](cfg& c) { c.history_every = 0.004; }},

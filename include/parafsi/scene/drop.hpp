@@ -24,7 +24,8 @@
 /// frame::follow_payload translates it with the payload mass centre and turns its −z axis
 /// to the payload velocity (box = follow), or frame::fixed (box = fixed, lengthened by
 /// fixed_fall). Far field + 3-cell sponge on all six faces. HLLC-LM + MUSCL (van Leer),
-/// SSP-RK2; constant μ or inviscid (`viscosity`). Pressure-gradient scaling α (`pgs_alpha`;
+/// SSP-RK2; constant μ or inviscid (`viscosity`), with an eddy-viscosity closure of the wake
+/// (`turbulence`, default Prandtl's mixing length). Pressure-gradient scaling α (`pgs_alpha`;
 /// 0 = auto: 8 with the embedded coupling, 1 with penalty, whose spring stiffness γp/α²
 /// it would soften): the air held at p/α². Coupling: embedded (default) or penalty (PFAC,
 /// stiffening λ), both with the fabric's Ergun law. The embedded coupling on the tensor box
@@ -104,10 +105,18 @@ struct drop_config {
   double refine_vorticity = 0;
   /// blocks: also hold the finest level on the tensor box's refined column (drop_column_target)
   bool refine_column = false;
-  std::string viscosity = "auto";  ///< constant | inviscid | auto (inviscid at draft/coarse/tiny)
-  /// none | mixing_length (Prandtl's, l_m = min(κ d_w, C_l D0, Δ), d_w from the canopy and
-  /// line nodes) | smagorinsky (C_s = 0.1); a closure brings the air's viscosity with it
-  std::string turbulence = "none";
+  /// constant | inviscid | auto (constant with a closure; without one inviscid at draft/coarse/tiny)
+  std::string viscosity = "auto";
+  /// The wake's eddy-viscosity closure: none | mixing_length (Prandtl's, the method's,
+  /// l_m = min(κ d_w, C_l D0, Δ), d_w from the canopy and line nodes) | smagorinsky
+  /// (C_s = 0.1) | auto (mixing_length, or none with viscosity = inviscid; chosen from the
+  /// 6 s drops, docs/validation.md §8.2); a closure brings the air's viscosity with it
+  std::string turbulence = "auto";
+  /// The closure this run uses (auto resolved).
+  std::string closure() const {
+    if (turbulence != "auto") return turbulence;
+    return viscosity == "inviscid" ? "none" : "mixing_length";
+  }
   double t_end = 6.0;            ///< simulated time (s)
   double history_every = 0.005;  ///< output interval (s)
   double force_cutoff = 10.0;    ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
@@ -164,9 +173,9 @@ struct drop_config {
             "beside the cloth are first order); use auto or first_order with --mesh blocks");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
-    require(one_of(turbulence, {"none", "mixing_length", "smagorinsky"}),
-            "parachute_drop: turbulence must be none, mixing_length or smagorinsky, got '", turbulence, "'");
-    require(turbulence == "none" || viscosity != "inviscid", "parachute_drop: --closure ", turbulence,
+    require(one_of(turbulence, {"auto", "none", "mixing_length", "smagorinsky"}),
+            "parachute_drop: closure must be auto, none, mixing_length or smagorinsky, got '", turbulence, "'");
+    require(closure() == "none" || viscosity != "inviscid", "parachute_drop: --closure ", turbulence,
             " is an eddy viscosity added to the air's: it cannot run with --viscosity inviscid");
     require(one_of(packed, {"scene", "reduced_radius", "star_fold", "bundle", "constructed"}),
             "parachute_drop: unknown packed shape '", packed, "'");
@@ -338,7 +347,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   // spring stiffness PFAC γp A/h would fall as 1/α²).
   su.alpha = c.pgs_alpha == 0.0 ? (c.coupling == "embedded" ? 8.0 : 1.0) : c.pgs_alpha;
   const bool coarse = c.resolution == "draft" || c.resolution == "coarse" || c.resolution == "tiny";
-  su.viscous = c.turbulence != "none" || !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
+  su.viscous = c.closure() != "none" || !(c.viscosity == "inviscid" || (c.viscosity == "auto" && coarse));
   return su;
 }
 
@@ -355,7 +364,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("coupling", c.coupling).add("pgs_alpha", su.alpha).add("impedance", c.impedance);
   g.add("pfac", c.pfac).add("stiffening", c.stiffening).add("coupling_damping", c.coupling_damping);
   g.add("viscosity", su.viscous ? "constant" : "inviscid").add("cfl", c.cfl);
-  if (c.turbulence != "none") g.add("turbulence", c.turbulence);
+  g.add("turbulence", c.closure());
   g.add("through_flow", c.through_flow);
   g.add("membrane_reconstruction", c.coupling != "embedded" ? "none" : (c.one_sided() ? "one_sided" : "first_order"));
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
@@ -796,7 +805,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   const fluid::prim<double> air{P.air_density, {0.0, 0.0, 0.0}, pgs.scaled_ambient(P.air_pressure)};
   auto bc = boundary::set::all(boundary::far_field{air.rho, air.u, air.p});
   bc.layer = {3, 0.5};
-  return detail::with_fluid_policies(su, c.turbulence, [&](auto visc, auto closure, auto frame) -> drop_result {
+  return detail::with_fluid_policies(su, c.closure(), [&](auto visc, auto closure, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
     const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
     if (c.mesh == "blocks") {

@@ -3,8 +3,8 @@
 // (default 40 m/s, Mach 0.12: low Mach, and half the acoustic steps of 20 m/s), run for
 // --flow-times D/U (default 16). Prints `drag_coefficient=<Cd>`, the time-weighted mean
 // over the second half of the run (t > t_end/2), and writes the CSV
-// `t,drag_coefficient,side_force_y,side_force_z` (one row per fluid step). Default run (--cells 8): about a minute on
-// one core.
+// `t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w` (one row per fluid step). Default run (--cells 8):
+// about a minute on one core.
 //
 // Drag = the force the coupling exerts on the body along the stream: the coupling's
 // structure impulse of each step, Σ_nodes F·x̂ Δt̄ (pinned nodes included), divided by

@@ -59,6 +59,9 @@ int main(int argc, char** argv) {
   examples::common_options co;
   std::string shape = "disk", coupling = "embedded", out, fabric = "none", closure = "none";
   double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0, kick = 0.0;
+  // The grid, in diameters: uniform cells of D/N in [-0.5, core_length] x [-core_width, core_width]^2,
+  // stretched out to [-2.5, domain_length] x [-domain_width, domain_width]^2.
+  double core_length = 1.5, core_width = 0.75, domain_length = 5.0, domain_width = 2.5, stretch = 1.15;
   int cells = 8;
   examples::add_run_options(app, co);
   app.add_option("--shape", shape, "disk (flat, normal to the stream) or cup (hemisphere, open towards the stream)")
@@ -97,6 +100,22 @@ int main(int argc, char** argv) {
       ->check(examples::finite)
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
+  app.add_option("--core-length", core_length, "downstream end of the uniform-cell core (diameters behind the body)")
+      ->check(CLI::Range(0.5, 50.0))
+      ->capture_default_str();
+  app.add_option("--core-width", core_width, "half-width of the uniform-cell core (diameters from the axis)")
+      ->check(CLI::Range(0.6, 20.0))
+      ->capture_default_str();
+  app.add_option("--domain-length", domain_length,
+                 "downstream end of the box (diameters behind the body; the wake probe is at 2)")
+      ->check(CLI::Range(2.5, 200.0))
+      ->capture_default_str();
+  app.add_option("--domain-width", domain_width, "half-width of the box (diameters from the axis)")
+      ->check(CLI::Range(1.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--stretch", stretch, "growth of the cells outside the core, per cell")
+      ->check(CLI::Range(1.0, 1.5))
+      ->capture_default_str();
   app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")
       ->check(CLI::Range(1e-4, 1e3))
       ->capture_default_str();
@@ -114,10 +133,16 @@ int main(int argc, char** argv) {
     const double t_avg = 0.5 * t_end;
     const double area = std::numbers::pi * R * R, qA = 0.5 * rho * U * U * area;
     // Grid refined around the body.
+    if (core_length > domain_length || core_width > domain_width)
+      throw std::invalid_argument("bluff_body_drag: the core (--core-length " + std::to_string(core_length) +
+                                  ", --core-width " + std::to_string(core_width) +
+                                  ") must lie inside the box (--domain-length, --domain-width)");
     using pf::fluid::axis;
-    auto grid = pf::fluid::rectilinear_grid{axis::refined(-2.5 * D, 5 * D, -0.5 * D, 1.5 * D, h, 1.15),
-                                            axis::refined(-2.5 * D, 2.5 * D, -0.75 * D, 0.75 * D, h, 1.15),
-                                            axis::refined(-2.5 * D, 2.5 * D, -0.75 * D, 0.75 * D, h, 1.15)};
+    const auto lateral = axis::refined(-domain_width * D, domain_width * D, -core_width * D, core_width * D, h,
+                                       stretch);
+    auto grid = pf::fluid::rectilinear_grid{axis::refined(-2.5 * D, domain_length * D, -0.5 * D, core_length * D, h,
+                                                          stretch),
+                                            lateral, lateral};
     pf::boundary::set bc = pf::boundary::set::all(pf::boundary::far_field{rho, {U, 0, 0}, p0});
     bc.layer.cells = 4;
     // Body: disk triangulation (normal +z) turned to face the stream, or mapped onto the
@@ -144,9 +169,12 @@ int main(int argc, char** argv) {
     if (!co.quiet)
       std::fprintf(stderr,
                    "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, grid %lld x %lld x %lld = %lld "
-                   "cells, %zu triangles, t_end = %g s (%g D/U), %s\n",
+                   "cells (core to %g D behind, +-%g D; box to %g D, +-%g D, blockage %.2g %%), %zu triangles, "
+                   "t_end = %g s (%g D/U), %s\n",
                    shape.c_str(), coupling.c_str(), D, U, cells, (long long)grid.n(0), (long long)grid.n(1),
-                   (long long)grid.n(2), (long long)grid.interior_cells(), dm.triangles.size(), t_end, t_end * U / D,
+                   (long long)grid.n(2), (long long)grid.interior_cells(), core_length, core_width, domain_length,
+                   domain_width, 100.0 * std::numbers::pi / 16.0 / (domain_width * domain_width), dm.triangles.size(),
+                   t_end, t_end * U / D,
                    mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str() : "inviscid");
 
     // Wake probe: the cell holding (2D, 0, 0).

@@ -416,6 +416,53 @@ TEST_CASE("descent mode on synthetic histories: coning, planar, gliding, vertica
   CHECK(lt.centre_crossings < 4);
 }
 
+TEST_CASE("terminal means over whole swing periods: the swing's phase does not bias v_T and C_D") {
+  // A planar swing of 15° with period T = 2.7 s over 8 s; speed and drag coefficient
+  // oscillate at twice the swing frequency (the drag is even in the tilt) about 7 m/s and
+  // 0.8. A window of whole periods gives the means; the fixed 2 s window takes a phase.
+  const double T = 2.7, w = 2 * std::numbers::pi / T, a = std::tan(io::rad(15.0)), t_end = 8.0;
+  auto h = descent(
+      t_end, [&](double t) { return Eigen::Vector2d(a * std::sin(w * t), 0.0); },
+      [&](double t) { return Eigen::Vector2d(1.5 * std::cos(w * t), 0.0); });
+  for (auto& r : h) {
+    r.speed = 7.0 + 0.3 * std::sin(2 * w * r.t + 0.4);
+    r.drag_coefficient = 0.8 + 0.05 * std::sin(2 * w * r.t + 0.4);
+  }
+  // Mean of A sin(k t + φ) over [t1, t2].
+  const auto mean_sin = [](double A, double k, double phi, double t1, double t2) {
+    return -A * (std::cos(k * t2 + phi) - std::cos(k * t1 + phi)) / (k * (t2 - t1));
+  };
+  const auto s = io::summarize(h, "swing");
+  REQUIRE(s.descent_mode == "planar");
+  CHECK(s.descent.swing_period == Approx(T).epsilon(1e-4));
+  CHECK(s.terminal_window == Approx(T).epsilon(1e-3));  // one period: ⌈2 / 2.7⌉ = 1
+  CHECK(s.v_terminal == Approx(7.0).epsilon(1e-4));
+  CHECK(s.cd_terminal == Approx(0.8).epsilon(1e-4));
+  // The fixed window (whole_periods off): the mean over [6, 8], off by the phase's share.
+  io::summary_options fixed;
+  fixed.whole_periods = false;
+  const auto f = io::summarize(h, "swing", fixed);
+  const double bias = mean_sin(0.3, 2 * w, 0.4, t_end - 2.0, t_end);
+  REQUIRE(std::fabs(bias) > 0.02);  // the case is one where the window matters
+  CHECK(f.terminal_window == Approx(2.0).epsilon(1e-9));
+  CHECK(f.v_terminal == Approx(7.0 + bias).epsilon(2e-4));
+  CHECK(f.cd_terminal == Approx(0.8 + bias / 6.0).epsilon(2e-4));
+  // A 5 s window holds ⌈5 / 2.7⌉ = 2 periods (5.4 s, inside [t_f, t_end] = [0, 8]).
+  io::summary_options longer;
+  longer.window = 5.0;
+  const auto l = io::summarize(h, "swing", longer);
+  CHECK(l.terminal_window == Approx(2 * T).epsilon(1e-3));
+  CHECK(l.v_terminal == Approx(7.0).epsilon(1e-4));
+  // A 6 s window would need 3 periods (8.1 s): only 2 fit after t_f.
+  longer.window = 6.0;
+  CHECK(io::summarize(h, "swing", longer).terminal_window == Approx(2 * T).epsilon(1e-3));
+  // Over the first 3 s the swing crosses its centre twice (1.35, 2.7 s): a half period seen,
+  // not a period; the means keep the fixed window.
+  const auto early = io::summarize(std::span<const io::drop_history_row>(h).first(601), "swing");
+  CHECK(early.descent.centre_crossings == 2);
+  CHECK(early.terminal_window == Approx(2.0).epsilon(1e-9));
+}
+
 TEST_CASE("history rows round-trip and the headers are the contract's") {
   CHECK(std::string(io::drop_history_header) ==
         "t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,canopy_phi_y,"

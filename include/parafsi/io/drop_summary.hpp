@@ -46,7 +46,14 @@
 ///           D_s, or the run is too short to have a steady window (a run of the opening
 ///           alone). A later peak of the ringing in descent (a filtered 18.8 N at 5.7 s
 ///           above the 18.2 N opening of the permeable mat509) is not the opening load.
-///   v_terminal, cd_terminal  means of speed and drag_coefficient over the last `window` s
+///   v_terminal, cd_terminal  means of speed and drag_coefficient over the terminal window
+///           `terminal_window`: the last `window` s, or, when the descent swings with a
+///           measured period T (`classify_descent` over [t_f, t_end], a whole period seen:
+///           three centre crossings or more) and `whole_periods` is set, the last n T seconds with n = ⌈window / T⌉
+///           whole periods, fewer (n ≥ 1) when n T would reach back before t_f (before the first row if D_s is never
+///           reached). Speed and drag oscillate with the swing
+///           (±0.05 in C_D on the default drop); a window of whole periods takes their mean,
+///           one that cuts a period takes a phase of it.
 ///   attitude_amplitude  peak canopy tilt from the vertical over the last `window` s, the
 ///           tilt of the axis with angles (φx, φy): atan(√(tan²φx + tan²φy))
 ///   descent_mode  `classify_descent` over the descent after full inflation, [t_f, t_end]
@@ -186,7 +193,8 @@ inline double drag_coefficient(double weight, double rho, double speed, double S
 }
 
 struct summary_options {
-  double window = 2.0;              ///< the "last seconds" of the terminal means (s)
+  double window = 2.0;              ///< the "last seconds" of D_s and (at least) of the terminal means (s)
+  bool whole_periods = true;        ///< terminal means over whole swing periods (file comment)
   double force_cutoff = 10.0;       ///< −3 dB frequency of the open-force filter (Hz; io/gaussian_filter.hpp)
   double sample_interval = 0.0;     ///< row interval (s) the filter assumes; 0 = (t_last − t_first)/(rows − 1)
   double overshoot_drop = 0.01;     ///< fall from the running maximum, / D_s, that ends the t_mo scan
@@ -224,6 +232,7 @@ struct drop_summary {
   double t_p_raw = 0, F_p_raw = 0;  ///< the raw sample maximum of open_force
   double v_terminal = 0, cd_terminal = 0, attitude_amplitude = 0;
   double steady_diameter = 0;                   ///< D_s
+  double terminal_window = 0;                   ///< the span of v_terminal, cd_terminal (s)
   double overshoot_diameter = 0;                ///< the diameter at t_mo
   double max_diameter = 0, t_max_diameter = 0;  ///< the largest diameter and its (first) time
   descent_statistics descent;
@@ -432,21 +441,30 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   const double t_w = t_end - o.window;
   std::size_t first = 0;
   while (first + 1 < h.size() && h[first].t < t_w - 1e-12) ++first;
-  double nd = 0, sumD = 0, sumV = 0, sumCd = 0, ncd = 0;
+  double nd = 0, sumD = 0;
   for (std::size_t i = first; i < h.size(); ++i) {
     const auto& r = h[i];
     sumD += r.canopy_diameter;
-    sumV += r.speed;
-    if (std::isfinite(r.drag_coefficient)) {
-      sumCd += r.drag_coefficient;
-      ncd += 1;
-    }
     s.attitude_amplitude = std::max(s.attitude_amplitude, tilt_from_angles(r.canopy_phi_x, r.canopy_phi_y));
     nd += 1;
   }
   s.steady_diameter = sumD / nd;
-  s.v_terminal = sumV / nd;
-  s.cd_terminal = ncd > 0 ? sumCd / ncd : std::numeric_limits<double>::quiet_NaN();
+  // Means of speed and drag coefficient over the rows from `from` on.
+  const auto terminal_means = [&](std::size_t from) {
+    double n = 0, sumV = 0, sumCd = 0, ncd = 0;
+    for (std::size_t i = from; i < h.size(); ++i) {
+      sumV += h[i].speed;
+      n += 1;
+      if (std::isfinite(h[i].drag_coefficient)) {
+        sumCd += h[i].drag_coefficient;
+        ncd += 1;
+      }
+    }
+    s.v_terminal = sumV / n;
+    s.cd_terminal = ncd > 0 ? sumCd / ncd : std::numeric_limits<double>::quiet_NaN();
+    s.terminal_window = t_end - h[from].t;
+  };
+  terminal_means(first);
   // The largest diameter.
   std::size_t imax = 0;
   for (std::size_t i = 0; i < h.size(); ++i)
@@ -496,9 +514,47 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
   s.t_p_raw = h[ip].t;
   s.F_p_raw = h[ip].open_force;
   // Descent mode over the rows after full inflation.
-  s.descent = classify_descent(h.subspan(i_f < h.size() ? i_f : 0), s.v_terminal, o);
+  const std::size_t i_descent = i_f < h.size() ? i_f : 0;
+  s.descent = classify_descent(h.subspan(i_descent), s.v_terminal, o);
   s.descent_mode = s.descent.mode;
+  // The terminal means over whole swing periods, when the swing has a period.
+  const double T = s.descent.swing_period;
+  if (o.whole_periods && std::isfinite(T) && T > 0 && s.descent.centre_crossings >= 3) {
+    const double span = t_end - h[i_descent].t;
+    double n = std::ceil(o.window / T - 1e-9);
+    if (n * T > span) n = std::floor(span / T);
+    if (n >= 1) {
+      // The first row at or after t_end − n T (rows are samples: the window is the
+      // sampled span closest to n T from above).
+      const double t0 = t_end - n * T;
+      std::size_t from = h.size() - 1;
+      while (from > 0 && h[from - 1].t >= t0 - 1e-12) --from;
+      if (from > 0 && t0 - h[from - 1].t < h[from].t - t0) --from;
+      terminal_means(from);
+    }
+  }
   return s;
+}
+
+/// The read-out behind a summary row as text, two lines each starting with `prefix`: the
+/// raw and filtered peak force (filter cut-off `force_cutoff` Hz), the overshoot, the
+/// largest diameter and the terminal window; the numbers of the descent mode.
+inline std::string summary_report(const drop_summary& m, double force_cutoff, const std::string& prefix = "") {
+  const auto& d = m.descent;
+  char a[512], b[640];
+  std::snprintf(a, sizeof a,
+                "F_p %.4g N at %.4g s (filtered at %g Hz; raw maximum %.4g N at %.4g s); t_mo %.4g s (D %.4g m; "
+                "largest D %.4g m at %.4g s); v_T %.4g m/s, C_D %.4g over the last %.4g s\n",
+                m.F_p, m.t_p, force_cutoff, m.F_p_raw, m.t_p_raw, m.t_mo, m.overshoot_diameter, m.max_diameter,
+                m.t_max_diameter, m.v_terminal, m.cd_terminal, m.terminal_window);
+  std::snprintf(b, sizeof b,
+                "descent %s over [%.4g, %.4g] s: peak tilt %.3g deg, swing amplitude %.3g deg, period %.4g s (%.3g "
+                "periods, %ld centre crossings; a mode needs 2 periods and 4 crossings), swept turns %.3g, "
+                "minor/major variance %.3g, drift %.3g of mean |v_h| %.3g m/s\n",
+                d.mode.c_str(), d.t_start, d.t_start + d.duration, d.peak_tilt, d.swing_amplitude, d.swing_period,
+                d.periods, d.centre_crossings, d.swept_turns, d.principal_ratio,
+                d.horizontal_speed > 0 ? d.drift_speed / d.horizontal_speed : 0.0, d.horizontal_speed);
+  return prefix + a + prefix + b;
 }
 
 /// Append one history row as CSV text (with its '\n') to `line`: the shortest text that

@@ -486,22 +486,9 @@ class drop_run {
  private:
   std::filesystem::path out() const { return std::filesystem::path(c_.out); }
 
-  /// The read-out behind the summary row, on stderr: raw and filtered peak force, the
-  /// overshoot and the largest diameter, the numbers of the descent mode.
+  /// The read-out behind the summary row, on stderr (io::summary_report).
   void report(const io::drop_summary& m) const {
-    const auto& d = m.descent;
-    std::fprintf(stderr,
-                 "parachute_drop: F_p %.4g N at %.4g s (filtered at %g Hz; raw maximum %.4g N at %.4g s); t_mo %.4g s "
-                 "(D %.4g m; largest D %.4g m at %.4g s)\n",
-                 m.F_p, m.t_p, c_.force_cutoff, m.F_p_raw, m.t_p_raw, m.t_mo, m.overshoot_diameter, m.max_diameter,
-                 m.t_max_diameter);
-    std::fprintf(stderr,
-                 "parachute_drop: descent %s over [%.4g, %.4g] s: peak tilt %.3g deg, swing amplitude %.3g deg, "
-                 "period %.4g s (%.3g periods, %ld centre crossings; a mode needs 2 periods and 4 crossings), swept "
-                 "turns %.3g, minor/major variance %.3g, drift %.3g of mean |v_h| %.3g m/s\n",
-                 d.mode.c_str(), d.t_start, d.t_start + d.duration, d.peak_tilt, d.swing_amplitude, d.swing_period,
-                 d.periods, d.centre_crossings, d.swept_turns, d.principal_ratio,
-                 d.horizontal_speed > 0 ? d.drift_speed / d.horizontal_speed : 0.0, d.horizontal_speed);
+    std::fputs(io::summary_report(m, c_.force_cutoff, "parachute_drop: ").c_str(), stderr);
   }
 
   /// The time loop from the start (its first row) or the restored state to t_end; returns

@@ -14,7 +14,9 @@
 // its rim in x = 0 and its pole at x = +R, the concave side facing the oncoming air).
 // Rectilinear grid with cells of D/N (N = --cells) in the box [−0.5D, 1.5D] × [−0.75D,
 // 0.75D]², stretched by 15 % per cell out to [−2.5D, 5D] × [−2.5D, 2.5D]² (blockage πD²/4
-// over 25D² = 3.1 %); characteristic far field on all six faces with a 4-cell sponge towards
+// over 25D² = 3.1 %) by default: `--core-length`, `--core-width` (core) and `--domain-length`,
+// `--domain-width` (box), in diameters behind the body and from the axis, and `--stretch` (the
+// growth) change it (coupling.md §8.1); characteristic far field on all six faces with a 4-cell sponge towards
 // the free stream; impulsive start from the uniform stream. HLLC-LM flux, MUSCL van
 // Leer, SSP-RK2. Inviscid by default (separation fixed by the sharp edge); --reynolds RE
 // switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer
@@ -133,10 +135,15 @@ int main(int argc, char** argv) {
     const double t_avg = 0.5 * t_end;
     const double area = std::numbers::pi * R * R, qA = 0.5 * rho * U * U * area;
     // Grid refined around the body.
-    if (core_length > domain_length || core_width > domain_width)
+    // The stretched part is empty or at least one core cell wide (no sliver cell that would
+    // cut the time step).
+    const auto gap_ok = [&](double core, double box) { return core == box || (box - core) * cells >= 1.0 - 1e-9; };
+    if (!gap_ok(core_length, domain_length) || !gap_ok(core_width, domain_width))
       throw std::invalid_argument("bluff_body_drag: the core (--core-length " + std::to_string(core_length) +
                                   ", --core-width " + std::to_string(core_width) +
-                                  ") must lie inside the box (--domain-length, --domain-width)");
+                                  ") must end at the box (--domain-length, --domain-width) or at least one cell "
+                                  "(1/" +
+                                  std::to_string(cells) + " D) inside it");
     using pf::fluid::axis;
     const auto lateral = axis::refined(-domain_width * D, domain_width * D, -core_width * D, core_width * D, h,
                                        stretch);
@@ -145,6 +152,9 @@ int main(int argc, char** argv) {
                                             lateral, lateral};
     pf::boundary::set bc = pf::boundary::set::all(pf::boundary::far_field{rho, {U, 0, 0}, p0});
     bc.layer.cells = 4;
+    if (grid.interior_cells() > 200'000'000)
+      throw std::invalid_argument("bluff_body_drag: the grid has " + std::to_string(grid.interior_cells()) +
+                                  " cells, more than 2e8 (fewer --cells, a smaller box or more --stretch)");
     // Body: disk triangulation (normal +z) turned to face the stream, or mapped onto the
     // hemisphere by equal meridian arc (polar angle θ = (r/R)·π/2, pole at x = +R).
     const int rings = std::max(2, (shape == "cup" ? 3 : 2) * cells / 4);
@@ -183,6 +193,9 @@ int main(int argc, char** argv) {
       const auto& f = grid.axis_of(d).faces;
       probe[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), d == 0 ? 2 * D : 0.0) - f.begin()) - 1;
     }
+    if (probe[0] >= grid.n(0) - bc.layer.cells)
+      throw std::invalid_argument("bluff_body_drag: the wake probe at 2 D lies in the far-field sponge (the last " +
+                                  std::to_string(bc.layer.cells) + " cells); lengthen the box (--domain-length)");
     auto run_with = [&](auto fl) -> int {
       fl.fill_uniform({rho, {U, kick * U, 0}, p0});
       if constexpr (decltype(fl)::needs_wall_distance) {

@@ -214,11 +214,12 @@ parafsi_example_dir_test(example_parachute_drop_tiny_through_flow_face parachute
   "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode"
   "1" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --through-flow face --quiet)
 parafsi_example_fails(example_parachute_drop_bad_through_flow parachute_drop --through-flow normal --out ${_ex_out}/unused_drop)
-# drop_readout recomputes that run's summary from its history.csv: the same row, byte for byte.
+# drop_readout recomputes that run's summary from its history.csv: the same row, byte for byte
+# (the history's numbers read back exactly; the window rules are test_drop_summary's).
 set_tests_properties(example_parachute_drop_tiny_pgs PROPERTIES FIXTURES_SETUP tiny_drop_history)
 add_test(NAME example_drop_readout_same_summary
   COMMAND ${CMAKE_COMMAND} -E chdir ${_ex_out} sh -c
-          "$<TARGET_FILE:drop_readout> --history example_parachute_drop_tiny_pgs/history.csv --fabric mat544 --history-every 0.005 --out drop_readout_summary.csv && ${CMAKE_COMMAND} -E compare_files drop_readout_summary.csv example_parachute_drop_tiny_pgs/summary.csv")
+          "'$<TARGET_FILE:drop_readout>' --history example_parachute_drop_tiny_pgs/history.csv --fabric mat544 --history-every 0.005 --out drop_readout_summary.csv && '${CMAKE_COMMAND}' -E compare_files drop_readout_summary.csv example_parachute_drop_tiny_pgs/summary.csv")
 set_tests_properties(example_drop_readout_same_summary PROPERTIES FIXTURES_REQUIRED tiny_drop_history TIMEOUT 60
   LABELS examples)
 parafsi_example_test(example_drop_readout_help drop_readout --help)

@@ -417,14 +417,16 @@ TEST_CASE("descent mode on synthetic histories: coning, planar, gliding, vertica
 }
 
 TEST_CASE("terminal means over whole swing periods: the swing's phase does not bias v_T and C_D") {
-  // A planar swing of 15° with period T = 2.7 s over 8 s; speed and drag coefficient
-  // oscillate at twice the swing frequency (the drag is even in the tilt) about 7 m/s and
-  // 0.8. A window of whole periods gives the means; the fixed 2 s window takes a phase.
-  const double T = 2.7, w = 2 * std::numbers::pi / T, a = std::tan(io::rad(15.0)), t_end = 8.0;
+  // A canopy that inflates over the first second (t_f ≈ 1 s) and then swings in a plane by
+  // 15° with period T = 2.7 s to 8.5 s; speed and drag coefficient oscillate at twice the
+  // swing frequency (the drag is even in the tilt) about 7 m/s and 0.8. A window of whole
+  // periods gives the means; the fixed 2 s window takes a phase.
+  const double T = 2.7, w = 2 * std::numbers::pi / T, a = std::tan(io::rad(15.0)), t_end = 8.5;
   auto h = descent(
       t_end, [&](double t) { return Eigen::Vector2d(a * std::sin(w * t), 0.0); },
       [&](double t) { return Eigen::Vector2d(1.5 * std::cos(w * t), 0.0); });
   for (auto& r : h) {
+    r.canopy_diameter = 0.7 * std::min(1.0, r.t) + 0.05 * std::exp(-std::pow((r.t - 1.1) / 0.1, 2));
     r.speed = 7.0 + 0.3 * std::sin(2 * w * r.t + 0.4);
     r.drag_coefficient = 0.8 + 0.05 * std::sin(2 * w * r.t + 0.4);
   }
@@ -433,12 +435,14 @@ TEST_CASE("terminal means over whole swing periods: the swing's phase does not b
     return -A * (std::cos(k * t2 + phi) - std::cos(k * t1 + phi)) / (k * (t2 - t1));
   };
   const auto s = io::summarize(h, "swing");
+  REQUIRE(s.t_f > 0.9);
+  REQUIRE(s.t_f < 1.0);
   REQUIRE(s.descent_mode == "planar");
   CHECK(s.descent.swing_period == Approx(T).epsilon(1e-4));
   CHECK(s.terminal_window == Approx(T).epsilon(1e-3));  // one period: ⌈2 / 2.7⌉ = 1
   CHECK(s.v_terminal == Approx(7.0).epsilon(1e-4));
   CHECK(s.cd_terminal == Approx(0.8).epsilon(1e-4));
-  // The fixed window (whole_periods off): the mean over [6, 8], off by the phase's share.
+  // The fixed window (whole_periods off): the mean over [6.5, 8.5], off by the phase's share.
   io::summary_options fixed;
   fixed.whole_periods = false;
   const auto f = io::summarize(h, "swing", fixed);
@@ -447,17 +451,18 @@ TEST_CASE("terminal means over whole swing periods: the swing's phase does not b
   CHECK(f.terminal_window == Approx(2.0).epsilon(1e-9));
   CHECK(f.v_terminal == Approx(7.0 + bias).epsilon(2e-4));
   CHECK(f.cd_terminal == Approx(0.8 + bias / 6.0).epsilon(2e-4));
-  // A 5 s window holds ⌈5 / 2.7⌉ = 2 periods (5.4 s, inside [t_f, t_end] = [0, 8]).
+  // A 5 s window holds ⌈5 / 2.7⌉ = 2 periods (5.4 s, inside [t_f, t_end]).
   io::summary_options longer;
   longer.window = 5.0;
   const auto l = io::summarize(h, "swing", longer);
   CHECK(l.terminal_window == Approx(2 * T).epsilon(1e-3));
   CHECK(l.v_terminal == Approx(7.0).epsilon(1e-4));
-  // A 6 s window would need 3 periods (8.1 s): only 2 fit after t_f.
+  // A 6 s window would need 3 periods (8.1 s): only 2 fit after t_f ≈ 1 s (3 would fit
+  // after the first row, t = 0).
   longer.window = 6.0;
   CHECK(io::summarize(h, "swing", longer).terminal_window == Approx(2 * T).epsilon(1e-3));
-  // Over the first 3 s the swing crosses its centre twice (1.35, 2.7 s): a half period seen,
-  // not a period; the means keep the fixed window.
+  // Over the first 3 s the swing crosses its centre twice after t_f (1.35, 2.7 s): a half
+  // period seen, not a period; the means keep the fixed window.
   const auto early = io::summarize(std::span<const io::drop_history_row>(h).first(601), "swing");
   CHECK(early.descent.centre_crossings == 2);
   CHECK(early.terminal_window == Approx(2.0).epsilon(1e-9));

@@ -319,7 +319,10 @@ inline std::vector<double> centre_crossings(std::span<const double> t, std::span
 ///                 (0.1) × v_T. Otherwise:
 ///   2. the swing: amplitude A = atan √(2 λ1); if A >= `swing_tilt` (2°), its period from
 ///                 the crossings of q·e1 through 0 (hysteresis ± 0.5 rms(q·e1)): with m ≥ 2
-///                 crossings c_1 … c_m, T = 2 (c_m − c_1)/(m − 1). The window must hold
+///                 crossings c_1 … c_m, T = (c_k − c_1)/((k − 1)/2) with k the last crossing
+///                 in the direction of c_1 (k − 1 even: whole periods, so an offset of the
+///                 centre, which moves rising and falling crossings apart, cancels), or
+///                 T = 2 (c_2 − c_1) from two crossings. The window must hold
 ///                 `min_periods` (2) periods of the swing: duration ≥ 2 T and m ≥ 2 × 2 = 4
 ///                 crossings (three half periods seen between the first and the last, so a
 ///                 swing that only starts late in the window does not pass on the window's
@@ -388,8 +391,12 @@ inline descent_statistics classify_descent(std::span<const drop_history_row> w, 
     }
     const auto c = detail::centre_crossings(t, s, 0.5 * std::sqrt(ss / double(n)));
     d.centre_crossings = long(c.size());
-    if (c.size() >= 2) {
-      d.swing_period = 2.0 * (c.back() - c.front()) / double(c.size() - 1);
+    if (c.size() >= 3) {
+      const std::size_t k = (c.size() - 1) / 2 * 2;  // crossings c[0], c[2], … go the same way
+      d.swing_period = (c[k] - c[0]) / double(k / 2);
+      d.periods = d.duration / d.swing_period;
+    } else if (c.size() == 2) {
+      d.swing_period = 2.0 * (c.back() - c.front());
       d.periods = d.duration / d.swing_period;
     }
     // Signed turning of q about the mean, off the centre band (reported also when the
@@ -524,8 +531,8 @@ inline drop_summary summarize(std::span<const drop_history_row> h, std::string f
     double n = std::ceil(o.window / T - 1e-9);
     if (n * T > span) n = std::floor(span / T);
     if (n >= 1) {
-      // The first row at or after t_end − n T (rows are samples: the window is the
-      // sampled span closest to n T from above).
+      // The row nearest to t_end − n T (the window is the sampled span closest to n T;
+      // it never starts before the descent's first row, since n T ≤ span).
       const double t0 = t_end - n * T;
       std::size_t from = h.size() - 1;
       while (from > 0 && h[from - 1].t >= t0 - 1e-12) --from;

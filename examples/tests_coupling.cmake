@@ -107,4 +107,15 @@ if(TARGET bluff_body_drag)
     --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_bad_coupling bluff_body_drag --coupling foo
     --out ${_cpl_out}/unused.csv)
+  # The grid's box and core: a larger box runs; a probe in the sponge, a sliver cell and a
+  # huge grid are refused.
+  parafsi_coupling_example(example_coupling_bluff_disk_box bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
+    "drag_coefficient=[0-9.e+-]+ " --shape disk --cells 4 --time 0.002 --core-length 3 --core-width 1 --domain-length 8
+    --domain-width 3 --stretch 1.2 --quiet)
+  parafsi_coupling_example_fails(example_coupling_bluff_probe_in_sponge bluff_body_drag --domain-length 2.5
+    --out ${_cpl_out}/unused.csv)
+  parafsi_coupling_example_fails(example_coupling_bluff_sliver_cell bluff_body_drag --core-width 2.49
+    --out ${_cpl_out}/unused.csv)
+  parafsi_coupling_example_fails(example_coupling_bluff_huge_grid bluff_body_drag --stretch 1 --domain-length 200
+    --domain-width 100 --out ${_cpl_out}/unused.csv)
 endif()

@@ -49,11 +49,11 @@
 ///   v_terminal, cd_terminal  means of speed and drag_coefficient over the terminal window
 ///           `terminal_window`: the last `window` s, or, when the descent swings with a
 ///           measured period T (`classify_descent` over [t_f, t_end], a whole period seen:
-///           three centre crossings or more) and `whole_periods` is set, the last n T seconds with n = ⌈window / T⌉
-///           whole periods, fewer (n ≥ 1) when n T would reach back before t_f (before the first row if D_s is never
-///           reached). Speed and drag oscillate with the swing
-///           (±0.05 in C_D on the default drop); a window of whole periods takes their mean,
-///           one that cuts a period takes a phase of it.
+///           three centre crossings or more) and `whole_periods` is set, the last n T
+///           seconds, n = ⌈window / T⌉ whole periods, fewer (n ≥ 1) when n T would reach
+///           back before t_f (before the first row if D_s is never reached). Speed and drag
+///           oscillate with the swing (±0.05 in C_D on the default drop); a window of whole
+///           periods takes their mean, one that cuts a period takes a phase of it.
 ///   attitude_amplitude  peak canopy tilt from the vertical over the last `window` s, the
 ///           tilt of the axis with angles (φx, φy): atan(√(tan²φx + tan²φy))
 ///   descent_mode  `classify_descent` over the descent after full inflation, [t_f, t_end]

@@ -220,7 +220,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--membrane-reconstruction", c.membrane_reconstruction,
                  "embedded: the cells beside the cloth reconstructed from their own side (one_sided, second order up "
-                 "to the membrane) or first order; auto: one_sided on the tensor box, first_order on blocks")
+                 "to the membrane) or first order; auto: one_sided")
       ->check(CLI::IsMember({"auto", "one_sided", "first_order"}))
       ->capture_default_str();
   app.add_option("--payload-mass", c.payload_mass, "override: payload mass (kg); default: the scene's")

@@ -348,8 +348,9 @@ parafsi_example_refuses(example_drop_guide_history_full drop_guide "history.csv"
 # structure::relax's step limit, tests/test_structure_cable.cpp; examples::step_guard).
 parafsi_example_refuses(example_hanging_chain_huge_EA hanging_chain "" "--EA: Value 1e300 not in range"
   --links 8 --length 1.2 --span 1 --EA 1e300 --out ${_ex_out}/unused_chain.csv)
-parafsi_example_refuses(example_parachute_drop_blocks_one_sided parachute_drop ""
-  "one_sided is not available on the block mesh" --mesh blocks --membrane-reconstruction one_sided --t-end 0.01)
+parafsi_example_dir_test(example_parachute_drop_tiny_blocks_first_order parachute_drop "summary.csv|mesh.csv"
+  "fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode|t,step,blocks,cells,cells_level_0,cells_level_1"
+  "1|2" "fabric,t_f,t_mo" --resolution tiny --t-end 0.02 --mesh blocks --block-size 4 --membrane-reconstruction first_order --quiet)
 parafsi_example_refuses(example_bluff_body_drag_tiny_reynolds bluff_body_drag ""
   "--reynolds: Reynolds number 1e-300 is neither 0" --reynolds 1e-300 --out ${_ex_out}/unused_bluff.csv)
 

@@ -67,7 +67,8 @@ void block_window(const S& s, double a, double b, double& p, double& u, int& lmi
 }
 }  // namespace
 
-TEST_CASE("embedded piston across a level boundary: the exact piston shock, no leak") {
+TEST_CASE_TEMPLATE("embedded piston across a level boundary: the exact piston shock, no leak", C, ctu::embedded,
+                   ctu::embedded_one_sided) {
   pf::parallel::set_threads(1);
   const double v = 2.0, t_end = 3e-3, x0 = 0.5;
   const auto d = pf::model::duct_screen(2.0, 100, x0);
@@ -80,7 +81,7 @@ TEST_CASE("embedded piston across a level boundary: the exact piston shock, no l
   st::assembly as{std::move(nd), std::move(mem)};
   as.integrator().gravity = {0, 0, 0};
   // Level 1 (1 cm cells) within 0.25 m of the plate: x in [0.24, 0.8]; the shock runs to 1.53 m.
-  auto s = block_duct(d, bc, 0.25, pf::coupling::embedded{pf::porosity::impermeable{}}, std::move(as), 0.0);
+  auto s = block_duct(d, bc, 0.25, C::make(pf::porosity::impermeable{}, 0), std::move(as), 0.0);
   while (s.time() < t_end - 1e-15) s.step(std::min(s.stable_dt(0.5), t_end - s.time()));
   const double c = std::sqrt(1.4 * p0 / rho0), xp = x0 + v * t_end, xf = x0 + c * t_end;
   const double cs = rho0 * c * v, q = 2.4 * v / c / 4.0, exact = cs * (q + std::sqrt(1.0 + q * q));
@@ -89,16 +90,17 @@ TEST_CASE("embedded piston across a level boundary: the exact piston shock, no l
   block_window(s, xp + 0.2 * (xf - xp), xp + 0.8 * (xf - xp), p, u, lmin, lmax);
   const double e_exact = (p - p0) / exact - 1.0;
   std::printf(
-      "embedded piston on blocks (levels %d-%d in the window): dp = %.2f Pa, exact shock %.2f Pa (%+.3f %%), "
+      "%s piston on blocks (levels %d-%d in the window): dp = %.2f Pa, exact shock %.2f Pa (%+.3f %%), "
       "u_air = %.5f m/s\n",
-      lmin, lmax, p - p0, exact, 100 * e_exact, u);
+      C::name, lmin, lmax, p - p0, exact, 100 * e_exact, u);
   CHECK(lmin == 0);
   CHECK(lmax == 1);
   CHECK(std::fabs(e_exact) < 0.005);
   CHECK(std::fabs(u - v) < 1e-3 * v);
 }
 
-TEST_CASE("embedded porous screen across level boundaries: the pressure drop on the Ergun law") {
+TEST_CASE_TEMPLATE("embedded porous screen across level boundaries: the pressure drop on the Ergun law", C,
+                   ctu::embedded, ctu::embedded_one_sided) {
   pf::parallel::set_threads(1);
   const double xs = 0.5;
   const auto d = pf::model::duct_screen(1.0, 40, xs);
@@ -111,7 +113,7 @@ TEST_CASE("embedded porous screen across level boundaries: the pressure drop on 
     bc.side(0, 1, pf::boundary::outflow{true, p0});
     // Level 1 within 5 cm of the sheet: x in [0.4, 0.6] (blocks of 0.1 m); the probes 0.1-0.2 m
     // either side are on level 0, so the air crosses a level boundary before and after the sheet.
-    auto s = block_duct(d, bc, 0.05, pf::coupling::embedded{law}, ctu::pinned_sheet(d), V, pf::flux::hllc{});
+    auto s = block_duct(d, bc, 0.05, C::make(law, 0), ctu::pinned_sheet(d), V, pf::flux::hllc{});
     while (s.time() < 0.06) s.step(s.stable_dt(0.5));
     double pu, uu, pd, ud;
     int l0, l1, m0, m1;
@@ -119,9 +121,9 @@ TEST_CASE("embedded porous screen across level boundaries: the pressure drop on 
     block_window(s, xs + 0.1, xs + 0.2, pd, ud, m0, m1);
     const double dp = pu - pd, ergun = law.pressure_jump(uu), err = dp / ergun - 1.0;
     std::printf(
-        "screen on blocks %-9s (probe levels %d-%d, %d-%d): through %.5g m/s, dp %7.2f Pa, Ergun %7.2f Pa, "
+        "%s screen on blocks %-9s (probe levels %d-%d, %d-%d): through %.5g m/s, dp %7.2f Pa, Ergun %7.2f Pa, "
         "error %+.3f %%\n",
-        std::string(fab.name).c_str(), l0, l1, m0, m1, uu, dp, ergun, 100 * err);
+        C::name, std::string(fab.name).c_str(), l0, l1, m0, m1, uu, dp, ergun, 100 * err);
     CHECK(s.fluid().tree().finest_level() == 1);
     CHECK(l1 == 0);
     CHECK(m1 == 0);

@@ -49,6 +49,40 @@ TEST_CASE("wall distance: the nearest point within the reach, +inf beyond, as a 
   CHECK(d[std::size_t(g.index(-1, 0, 0))] == -7.0);  // a ghost cell is left alone
 }
 
+TEST_CASE("wall distance with ghosts: points outside the grid within and beyond the reach, as a brute force") {
+  // A block-sized grid and points spread over a region three times as wide: the points
+  // farther than the reach outside its cells are skipped, the others still count.
+  const auto g = fluid::rectilinear_grid::uniform({8, 8, 8}, {0.0, 0.0, 0.0}, {0.4, 0.4, 0.4});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.4, 0.8);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < 300; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
+  const double reach = 0.12;
+  std::vector<double> d(std::size_t(g.total_cells()), -7.0);
+  fluid::distance_to_points(g, pts, reach, d, true);
+  const index_t ng = fluid::rectilinear_grid::ghosts;
+  int inside = 0, beyond = 0, wrong = 0;
+  for (index_t k = -ng; k < g.n(2) + ng; ++k)
+    for (index_t j = -ng; j < g.n(1) + ng; ++j)
+      for (index_t i = -ng; i < g.n(0) + ng; ++i) {
+        const Eigen::Vector3d x(g.centre(0, i), g.centre(1, j), g.centre(2, k));
+        double best = 1e300;
+        for (const auto& p : pts) best = std::min(best, (x - p).norm());
+        const double got = d[std::size_t(g.index(i, j, k))];
+        if (best <= reach) {
+          ++inside;
+          if (std::fabs(got - best) > 1e-15) ++wrong;
+        } else {
+          ++beyond;
+          if (got != 1e30) ++wrong;
+        }
+      }
+  MESSAGE(inside, " cells (ghosts included) within the reach, ", beyond, " beyond, ", wrong, " differ");
+  CHECK(inside > 100);
+  CHECK(beyond > 10);
+  CHECK(wrong == 0);
+}
+
 TEST_CASE("wall distance: points on a sphere bound the distance to the sphere") {
   const double R = 0.3, pi = std::numbers::pi;
   const int nth = 40, nph = 80;  // spacing ≤ π R / 40 ≈ 0.024 m

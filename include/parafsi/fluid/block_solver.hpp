@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
@@ -736,15 +737,17 @@ class block_solver {
                                                                                                           keep);
   }
 
-  /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp, first-
-  /// order membrane states): each face's regular flux is recomputed on the high cell's
-  /// block, whose ghost layer holds the low cell (a same-level copy), and the two cells'
-  /// rates are corrected, dU_low += (F − F_lo)/Δx, dU_high −= (F − F_hi)/Δx. Both cells
-  /// must be leaf cells of one level inside the box.
+  /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp): each
+  /// face's regular flux is recomputed on the high cell's block, whose ghost layer holds the
+  /// low cell (a same-level copy), and the two cells' rates are corrected,
+  /// dU_low += (F − F_lo)/Δx, dU_high −= (F − F_hi)/Δx. Both cells must be leaf cells of one
+  /// level inside the box. With a one-sided patcher the membrane sees the cells' one-sided
+  /// values and the unblocked neighbouring faces are recomputed with them, each cell on its
+  /// own block (its stencil of two cells on the open side lies in that block's ghost layer),
+  /// as on the box: the same values and corrections, to round-off, on one level.
   template <class Patcher>
   void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
-    static_assert(!detail::wants_one_sided<Patcher>(),
-                  "fluid::block_solver: one-sided reconstruction beside membrane faces is not on the block mesh yet");
+    constexpr bool one_sided = detail::wants_one_sided<Patcher>() && Recon::second_order;
     const std::span<const patch_face> faces = patcher.patch_faces();
     const fluid::view state = view();
     const auto dU = detail::conserved_ptrs(*dU_);
@@ -753,16 +756,29 @@ class block_solver {
       const int d = faces[pi].axis;
       require(d >= 0 && d < 3 && c >= 0 && c < stride_ * block_count(), "fluid::block_solver: bad patched face ", pi,
               " (cell ", c, ", axis ", d, ")");
-      const index_t id = c / stride_, lc = c % stride_;
-      const block& b = blocks_[std::size_t(id)];
-      const auto ijk = b.grid.ijk(lc);
-      const index_t ic = ijk[std::size_t(d)];
+      const block& b = blocks_[std::size_t(c / stride_)];
+      const auto ijk = b.grid.ijk(c % stride_);
       const index_t m = neighbour(c, d, 0);
-      require(ic >= 0 && ic < n_ && ijk[std::size_t((d + 1) % 3)] >= 0 && ijk[std::size_t((d + 1) % 3)] < n_ &&
-                  ijk[std::size_t((d + 2) % 3)] >= 0 && ijk[std::size_t((d + 2) % 3)] < n_ && m >= 0,
+      require(ijk[0] >= 0 && ijk[0] < n_ && ijk[1] >= 0 && ijk[1] < n_ && ijk[2] >= 0 && ijk[2] < n_ && m >= 0,
               "fluid::block_solver: patched face ", pi, " (cell ", c, ", axis ", d,
               ") is not between two leaf cells of one level inside the box: the membrane must lie on one level "
               "(refine around it)");
+    }
+    if constexpr (one_sided) {
+      if (blocked_.size() != std::size_t(stride_ * block_count()))
+        blocked_.assign(std::size_t(stride_ * block_count()), 0);
+      for (const patch_face& f : faces) {
+        blocked_[std::size_t(f.high)] |= std::uint8_t(1u << (2 * f.axis));
+        blocked_[std::size_t(neighbour(f.high, f.axis, 0))] |= std::uint8_t(1u << (2 * f.axis + 1));
+      }
+    }
+    for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+      const index_t c = faces[pi].high;
+      const int d = faces[pi].axis;
+      const index_t id = c / stride_, lc = c % stride_;
+      const block& b = blocks_[std::size_t(id)];
+      const index_t ic = b.grid.ijk(lc)[std::size_t(d)];
+      const index_t m = neighbour(c, d, 0);
       // The low cell lies in this block's ghost layer when ic = 0.
       const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
                                                 detail::primitive_ptrs(std::as_const(b.W))};
@@ -772,11 +788,83 @@ class block_solver {
       fc.stage = stage;
       fc.patch = pi;
       const cons<double> F = detail::regular_face(fk, geo, d, lc, fc);
+      if constexpr (one_sided)
+        detail::with_axis(d, [&](auto D) { one_sided_patch<decltype(D)::value>(geo, c, fc, dU); });
       cons<double> Flo = F, Fhi = F;
       patcher.patch(fc, state, Flo, Fhi);
       detail::apply_face_patch(F, Flo, Fhi, m, b.grid.inv_widths(d)[ic - 1], true, c, b.grid.inv_widths(d)[ic], true,
                                dU);
     }
+    if constexpr (one_sided)
+      for (const patch_face& f : faces) {
+        blocked_[std::size_t(f.high)] = 0;
+        blocked_[std::size_t(neighbour(f.high, f.axis, 0))] = 0;
+      }
+  }
+
+  /// A cell as the one-sided reconstruction reads it: the block whose grid holds it (its
+  /// own, or for a ghost outside the box the block it borders), its index there, its index
+  /// along the axis, and its global index (−1: a ghost outside the box).
+  struct cell_ref {
+    index_t id, local, ia, global;
+  };
+  /// The cell next to r along axis d (side 0: low, 1: high); stops the run where the
+  /// neighbour is a leaf of another level (a level boundary within the one-sided stencil).
+  cell_ref step_ref(const cell_ref& r, int d, int side) const {
+    const block& b = blocks_[std::size_t(r.id)];
+    auto ijk = b.grid.ijk(r.local);
+    ijk[std::size_t(d)] += side ? 1 : -1;
+    const index_t ia = ijk[std::size_t(d)];
+    if (r.global >= 0 && (ia < 0 || ia >= n_)) {
+      const index_t g = neighbour(r.global, d, side);
+      if (g >= 0) return {g / stride_, g % stride_, side ? 0 : n_ - 1, g};
+      require(b.boundary[std::size_t(2 * d + side)], "fluid::block_solver: a level boundary (block ", r.id, ", axis ",
+              d, ") lies within the one-sided stencil of a membrane face: refine around the membrane");
+      return {r.id, b.grid.index(ijk[0], ijk[1], ijk[2]), ia, -1};
+    }
+    return {r.id, b.grid.index(ijk[0], ijk[1], ijk[2]), ia,
+            r.global < 0 ? -1 : global_index(r.id, b.grid.index(ijk[0], ijk[1], ijk[2]))};
+  }
+  /// r's blocked faces along D (blocked_ marks; a ghost outside the box has none).
+  template <int D>
+  detail::blocked_faces blocked_of(const cell_ref& r) const {
+    constexpr std::uint8_t lo_bit = std::uint8_t(1u << (2 * D)), hi_bit = std::uint8_t(1u << (2 * D + 1));
+    auto bits = [&](const cell_ref& q) { return q.global >= 0 ? blocked_[std::size_t(q.global)] : std::uint8_t(0); };
+    detail::blocked_faces bf;
+    bf.lo = bits(r) & lo_bit;
+    bf.hi = bits(r) & hi_bit;
+    if (bf.lo != bf.hi) bf.far = bits(step_ref(r, D, bf.hi ? 0 : 1)) & (bf.hi ? lo_bit : hi_bit);
+    return bf;
+  }
+  /// The face kernel of the block whose grid holds r.
+  detail::face_kernel<Flux, Recon> kernel_of(const cell_ref& r) const {
+    const block& b = blocks_[std::size_t(r.id)];
+    return {flux_, recon_, gas_, b.grid, detail::primitive_ptrs(std::as_const(b.W))};
+  }
+  /// The one-sided part of the patch of the face below cell c along D (detail/patch_faces.hpp):
+  /// the membrane's face states (fc.L, fc.R) and the corrections of the unblocked
+  /// neighbouring faces, each once.
+  template <int D>
+  void one_sided_patch(const detail::stage_geometry& geo, index_t c, face_context& fc,
+                       const detail::fields5<double>& dU) const {
+    using side = detail::face_side<Flux, Recon>;
+    const cell_ref hc{c / stride_, c % stride_, blocks_[std::size_t(c / stride_)].grid.ijk(c % stride_)[std::size_t(D)],
+                      c};
+    const cell_ref lc = step_ref(hc, D, 0), below = step_ref(lc, D, 0), above = step_ref(hc, D, 1);
+    const auto fk_l = kernel_of(lc), fk_h = kernel_of(hc), fk_b = kernel_of(below), fk_a = kernel_of(above);
+    const side L{&fk_l, lc.local, lc.ia, blocked_of<D>(lc), true}, H{&fk_h, hc.local, hc.ia, blocked_of<D>(hc), true};
+    double l1[5], h1[5];
+    detail::one_sided_cell_faces<D>(fk_l, L.bf, L.cell, L.ia, l1, h1);
+    fc.L = detail::prim_of(h1);
+    detail::one_sided_cell_faces<D>(fk_h, H.bf, H.cell, H.ia, l1, h1);
+    fc.R = detail::prim_of(l1);
+    if (!L.bf.lo) {
+      const side B{&fk_b, below.local, below.ia, blocked_of<D>(below), below.global >= 0};
+      detail::move_face_change<D>(detail::neighbour_face_change<D>(geo, B, L), B, below.global, L, lc.global, dU);
+    }
+    const side A{&fk_a, above.local, above.ia, blocked_of<D>(above), above.global >= 0};
+    if (!H.bf.hi && !A.bf.hi)
+      detail::move_face_change<D>(detail::neighbour_face_change<D>(geo, H, A), H, hc.global, A, above.global, dU);
   }
 
   /// Every block's face ghosts from neighbours, then the box's boundary conditions; edge
@@ -970,6 +1058,7 @@ class block_solver {
   std::unique_ptr<prim_storage> W_;
   std::unique_ptr<source_storage> S_;      ///< null until enable_sources
   std::unique_ptr<turbulence_storage> T_;  ///< with an eddy-viscosity closure
+  std::vector<std::uint8_t> blocked_;      ///< membrane faces' marks (one-sided patches; global_index)
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;

@@ -28,10 +28,10 @@
 /// (`turbulence`, default Prandtl's mixing length). Pressure-gradient scaling α (`pgs_alpha`;
 /// 0 = auto: 8 with the embedded coupling, 1 with penalty, whose spring stiffness γp/α²
 /// it would soften): the air held at p/α². Coupling: embedded (default) or penalty (PFAC,
-/// stiffening λ), both with the fabric's Ergun law. The embedded coupling on the tensor box
-/// reconstructs the cells beside the cloth from their own side (`membrane_reconstruction`
-/// auto or one_sided: coupling::embedded<P, true>, second order up to the membrane); on the
-/// block mesh they are first order (one-sided is not available there).
+/// stiffening λ), both with the fabric's Ergun law. The embedded coupling reconstructs the
+/// cells beside the cloth from their own side on either mesh (`membrane_reconstruction`
+/// auto or one_sided: coupling::embedded<P, true>, second order up to the membrane), or
+/// takes their own values (first_order).
 ///
 /// Loop (each step): the stable step at `cfl`, shortened to land on the next output
 /// instant n · history_every (an integer n, so a restarted run takes the steps of the
@@ -130,12 +130,10 @@ struct drop_config {
   /// (each grid face's own, the rule before 2026-12; coupling::through_flow_law)
   std::string through_flow = "cloth";
   /// embedded: the cells beside the cloth reconstructed from their own side (one_sided) or
-  /// first order (first_order); auto = one_sided on the tensor box, first_order on blocks
+  /// first order (first_order); auto = one_sided
   std::string membrane_reconstruction = "auto";
   /// Whether the run's embedded coupling reconstructs the cells beside the cloth one-sided.
-  bool one_sided() const {
-    return coupling == "embedded" && mesh == "tensor" && membrane_reconstruction != "first_order";
-  }
+  bool one_sided() const { return coupling == "embedded" && membrane_reconstruction != "first_order"; }
   double pgs_alpha = 0.0;        ///< pressure-gradient scaling α ≥ 1; 1 = off, 0 = auto (pressure_scaling.hpp)
   double cell = 0, element = 0;  ///< overrides of the resolution (/ D0), 0 = the resolution's
   double initial_speed = -1;     ///< override of the scene's release speed (m/s), < 0 = scene
@@ -168,9 +166,6 @@ struct drop_config {
     require(one_of(membrane_reconstruction, {"auto", "one_sided", "first_order"}),
             "parachute_drop: membrane reconstruction must be auto, one_sided or first_order, got '",
             membrane_reconstruction, "'");
-    require(!(mesh == "blocks" && membrane_reconstruction == "one_sided"),
-            "parachute_drop: --membrane-reconstruction one_sided is not available on the block mesh (its cells "
-            "beside the cloth are first order); use auto or first_order with --mesh blocks");
     require(one_of(viscosity, {"auto", "constant", "inviscid"}),
             "parachute_drop: viscosity must be auto, constant or inviscid, got '", viscosity, "'");
     require(one_of(turbulence, {"auto", "none", "mixing_length", "smagorinsky"}),
@@ -807,9 +802,13 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
         coupling::embedded_options eo;
         eo.impedance = c.impedance;
         eo.law_on = coupling::through_flow_law_named(c.through_flow);
-        using C = coupling::embedded<porosity::ergun>;
-        detail::drop_run<decltype(fl), C> run{c, su, std::move(fl), std::move(chute), C{law, eo}, levels};
-        return run.run(progress);
+        auto go = [&](auto cpl) -> drop_result {
+          detail::drop_run<decltype(fl), decltype(cpl)> run{c,     su, std::move(fl), std::move(chute), std::move(cpl),
+                                                            levels};
+          return run.run(progress);
+        };
+        if (c.one_sided()) return go(coupling::embedded<porosity::ergun, true>{law, eo});
+        return go(coupling::embedded{law, eo});
       }
       coupling::penalty_options po;
       po.pfac = c.pfac;

@@ -13,6 +13,7 @@
 ///     outside the box or on a coarser level counts as a zero one-sided difference; a
 ///     stencil cell covered by finer cells is their mean. If the result is not a gas
 ///     (ρ ≤ 0 or p ≤ 0) the ghost takes U_c.
+/// The ghost cells one coarse cell covers share its slopes, computed once per group.
 /// Copies run as boxes of cells (block_plan::copy_box): the per-cell items merged where
 /// destination and source are both contiguous, along x, then y, then z (a face slab of
 /// n × n × 2 cells is one box), so the exchange is a few contiguous loops per field.
@@ -30,6 +31,8 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "../../core/error.hpp"
@@ -53,11 +56,14 @@ struct block_plan {
   struct copy_item {
     index_t dst, src_block, src;
   };
-  struct prolong_item {
-    index_t dst;
+  /// The ghost cells of this block that one coarse cell covers (up to its 8 children):
+  /// the coarse cell's slopes are computed once for all of them.
+  struct prolong_group {
     value_ref centre;
     std::array<value_ref, 6> side;  ///< −x, +x, −y, +y, −z, +z neighbours of the coarse cell
-    std::array<double, 3> offset;   ///< δ_d = ±¼
+    int count = 0;                  ///< children filled from it
+    std::array<index_t, 8> dst{};
+    std::array<std::array<double, 3>, 8> offset{};  ///< δ_d = ±¼ of each child
   };
   /// Cells dst + a + b s_y + c s_z ← src + a + b s_y + c s_z (a < extent[0], b < extent[1],
   /// c < extent[2]; s_y, s_z the strides of a block) from a leaf of the same level.
@@ -67,7 +73,7 @@ struct block_plan {
   };
   std::vector<copy_box> copies;
   std::vector<copy_item> restrictions;  ///< src: the lowest fine cell of the 2×2×2 group
-  std::vector<prolong_item> prolongations;
+  std::vector<prolong_group> prolongations;
 };
 
 /// Cells per block edge n (even, ≥ 4: two ghost layers of a fine block lie in one coarse
@@ -166,11 +172,13 @@ inline std::vector<block_plan> build_plan(const tree& t, index_t n, bool edges =
 
   std::vector<block_plan> plans(std::size_t(t.size()));
   std::vector<block_plan::copy_item> copies;
+  std::map<std::pair<index_t, index_t>, std::size_t> group_of;  // coarse (block, cell) → group
   for (index_t b = 0; b < t.size(); ++b) {
     const location q = t.leaf(b);
     const int L = q.level;
     block_plan& p = plans[std::size_t(b)];
     copies.clear();
+    group_of.clear();
     for (index_t k = -g; k < n + g; ++k)
       for (index_t j = -g; j < n + g; ++j)
         for (index_t i = -g; i < n + g; ++i) {
@@ -196,18 +204,25 @@ inline std::vector<block_plan> build_plan(const tree& t, index_t n, bool edges =
                     "level ",
                     L, " block (", q.l[0], ", ", q.l[1], ", ", q.l[2], ")");
             const std::array<std::int64_t, 3> C{floor_div(G[0], 2), floor_div(G[1], 2), floor_div(G[2], 2)};
-            block_plan::prolong_item it{};
-            it.dst = dst;
-            it.centre = {c.id, local(C, t.leaf(c.id)), false};
-            for (int d = 0; d < 3; ++d) {
-              it.offset[std::size_t(d)] = (G[std::size_t(d)] - 2 * C[std::size_t(d)]) == 0 ? -0.25 : 0.25;
-              for (int s = 0; s < 2; ++s) {
-                auto Cn = C;
-                Cn[std::size_t(d)] += s ? 1 : -1;
-                it.side[std::size_t(2 * d + s)] = value_at(Cn, L - 1);
-              }
+            const value_ref centre{c.id, local(C, t.leaf(c.id)), false};
+            const auto [slot, fresh] = group_of.try_emplace({centre.block, centre.cell}, p.prolongations.size());
+            if (fresh) {
+              block_plan::prolong_group grp;
+              grp.centre = centre;
+              for (int d = 0; d < 3; ++d)
+                for (int s = 0; s < 2; ++s) {
+                  auto Cn = C;
+                  Cn[std::size_t(d)] += s ? 1 : -1;
+                  grp.side[std::size_t(2 * d + s)] = value_at(Cn, L - 1);
+                }
+              p.prolongations.push_back(grp);
             }
-            p.prolongations.push_back(it);
+            block_plan::prolong_group& grp = p.prolongations[slot->second];
+            const int k8 = grp.count++;
+            grp.dst[std::size_t(k8)] = dst;
+            for (int d = 0; d < 3; ++d)
+              grp.offset[std::size_t(k8)][std::size_t(d)] = (G[std::size_t(d)] - 2 * C[std::size_t(d)]) == 0 ? -0.25
+                                                                                                             : 0.25;
           }
         }
     p.copies = merge_copies(copies, n + 2 * g, (n + 2 * g) * (n + 2 * g));
@@ -249,22 +264,29 @@ inline void execute_plan(const block_plan& p, index_t b, const block_fields& U, 
     const double* u = U[std::size_t(r.block)][f];
     return r.restricted ? restrict8(u, r.cell, sy, sz) : u[r.cell];
   };
-  for (const auto& it : p.prolongations) {
-    double q[5], c[5];
+  for (const auto& grp : p.prolongations) {
+    // The coarse cell and its limited slopes, once for the group's children.
+    double c[5], sl[5][3];
     for (int f = 0; f < 5; ++f) {
-      c[f] = value(it.centre, f);
-      q[f] = c[f];
+      c[f] = value(grp.centre, f);
       for (int d = 0; d < 3; ++d) {
-        const value_ref& lo = it.side[std::size_t(2 * d)];
-        const value_ref& hi = it.side[std::size_t(2 * d + 1)];
+        const value_ref& lo = grp.side[std::size_t(2 * d)];
+        const value_ref& hi = grp.side[std::size_t(2 * d + 1)];
         const double a = lo.block >= 0 ? c[f] - value(lo, f) : 0.0;
         const double bb = hi.block >= 0 ? value(hi, f) - c[f] : 0.0;
-        const double s = a * bb > 0.0 ? (std::fabs(a) < std::fabs(bb) ? a : bb) : 0.0;  // minmod
-        q[f] += it.offset[std::size_t(d)] * s;
+        sl[f][d] = a * bb > 0.0 ? (std::fabs(a) < std::fabs(bb) ? a : bb) : 0.0;  // minmod
       }
     }
-    const bool gas_ok = q[0] > 0.0 && gas.pressure(q[0], q[1], q[2], q[3], q[4]) > 0.0;
-    for (int f = 0; f < 5; ++f) dst[f][it.dst] = gas_ok ? q[f] : c[f];
+    for (int k8 = 0; k8 < grp.count; ++k8) {
+      const auto& off = grp.offset[std::size_t(k8)];
+      double q[5];
+      for (int f = 0; f < 5; ++f) {
+        q[f] = c[f];
+        for (int d = 0; d < 3; ++d) q[f] += off[std::size_t(d)] * sl[f][d];
+      }
+      const bool gas_ok = q[0] > 0.0 && gas.pressure(q[0], q[1], q[2], q[3], q[4]) > 0.0;
+      for (int f = 0; f < 5; ++f) dst[f][grp.dst[std::size_t(k8)]] = gas_ok ? q[f] : c[f];
+    }
   }
 }
 

@@ -57,35 +57,39 @@ inline double face_speed(const stage_geometry& geo, int d, const Eigen::Vector3d
   return geo.vh[d] + geo.oh.cross(x)[d];
 }
 
-/// Face values of `cell` along D (flat index, index ia along D): the two-sided MUSCL
-/// values where neither face along D is blocked (bit 2D: low face, 2D + 1: high face of
-/// `blocked`), else the one-sided values of the file comment.
+/// The blocked faces of a cell along one axis as the one-sided reconstruction reads them:
+/// its low and high face, and the far face of the neighbour on its open side (face i − 3/2
+/// of a cell blocked on its high face, i + 3/2 of one blocked on its low face).
+struct blocked_faces {
+  bool lo = false, hi = false, far = false;
+};
+
+/// Face values of `cell` along D (flat index of fk's grid, index ia along D): the
+/// two-sided MUSCL values where neither face along D is blocked, else the one-sided values
+/// of the file comment.
 template <int D, class Flux, class Recon>
-void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<std::uint8_t>& blocked, index_t cell,
-                        index_t ia, double* lo, double* hi) {
-  const index_t s = fk.grid.stride(D);
-  const std::uint8_t lo_bit = std::uint8_t(1u << (2 * D)), hi_bit = std::uint8_t(1u << (2 * D + 1));
-  const bool lo_b = blocked[std::size_t(cell)] & lo_bit, hi_b = blocked[std::size_t(cell)] & hi_bit;
-  if (!lo_b && !hi_b) {
+void one_sided_cell_faces(const face_kernel<Flux, Recon>& fk, blocked_faces bf, index_t cell, index_t ia, double* lo,
+                          double* hi) {
+  if (!bf.lo && !bf.hi) {
     sweep_cell_faces<D>(fk, cell, ia, lo, hi);
     return;
   }
   double q[5];
   for (int f = 0; f < 5; ++f) q[f] = fk.W[f][cell];
   if constexpr (Recon::second_order) {
-    if (!(lo_b && hi_b)) {
+    if (!(bf.lo && bf.hi)) {
+      const index_t s = fk.grid.stride(D);
       const double* idc = fk.grid.inv_centre_gaps(D);
       const double h = fk.grid.half_widths(D)[ia];
       // Towards the open side: the near difference a and the next one b (or a again).
-      const index_t o = hi_b ? -s : s;  // step into the open side
-      const bool far_blocked = blocked[std::size_t(cell + o)] & (hi_b ? lo_bit : hi_bit);
-      const double ia_near = hi_b ? idc[ia] : idc[ia + 1], ia_far = hi_b ? idc[ia - 1] : idc[ia + 2];
-      const double sg = hi_b ? 1.0 : -1.0;  // differences taken low → high
+      const index_t o = bf.hi ? -s : s;  // step into the open side
+      const double ia_near = bf.hi ? idc[ia] : idc[ia + 1], ia_far = bf.hi ? idc[ia - 1] : idc[ia + 2];
+      const double sg = bf.hi ? 1.0 : -1.0;  // differences taken low → high
       double l[5], r[5];
       for (int f = 0; f < 5; ++f) {
         const double* w = fk.W[f];
         const double a = sg * (w[cell] - w[cell + o]) * ia_near;
-        const double b = far_blocked ? a : sg * (w[cell + o] - w[cell + 2 * o]) * ia_far;
+        const double b = bf.far ? a : sg * (w[cell + o] - w[cell + 2 * o]) * ia_far;
         const double d = fk.recon.slope(a, b) * h;
         l[f] = q[f] - d;
         r[f] = q[f] + d;
@@ -103,32 +107,81 @@ void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<st
   for (int f = 0; f < 5; ++f) lo[f] = hi[f] = q[f];
 }
 
+/// The blocked faces of `cell` along D from the box's marks (bit 2D: low face, 2D + 1:
+/// high face of `blocked`).
+template <int D>
+blocked_faces blocked_along(const std::vector<std::uint8_t>& blocked, index_t cell, index_t s) {
+  const std::uint8_t lo_bit = std::uint8_t(1u << (2 * D)), hi_bit = std::uint8_t(1u << (2 * D + 1));
+  blocked_faces bf;
+  bf.lo = blocked[std::size_t(cell)] & lo_bit;
+  bf.hi = blocked[std::size_t(cell)] & hi_bit;
+  if (bf.lo != bf.hi) bf.far = blocked[std::size_t(cell + (bf.hi ? -s : s))] & (bf.hi ? lo_bit : hi_bit);
+  return bf;
+}
+
+/// Face values of `cell` along D on the box (one_sided_cell_faces with the box's marks).
+template <int D, class Flux, class Recon>
+void blocked_cell_faces(const face_kernel<Flux, Recon>& fk, const std::vector<std::uint8_t>& blocked, index_t cell,
+                        index_t ia, double* lo, double* hi) {
+  one_sided_cell_faces<D>(fk, blocked_along<D>(blocked, cell, fk.grid.stride(D)), cell, ia, lo, hi);
+}
+
 inline prim<double> prim_of(const double* v) { return {v[0], {v[1], v[2], v[3]}, v[4]}; }
 
-/// Recompute the unblocked face between cells a (low, index ia along D) and a + s with
-/// the one-sided values and move the difference to the sweeps' flux between the cells.
+/// One cell beside a recomputed face: the face kernel of the grid that holds it (the
+/// box's, or a block's), its flat index there and index along the axis, its blocked faces,
+/// and whether its rate is updated (false for a ghost outside the box).
+template <class Flux, class Recon>
+struct face_side {
+  const face_kernel<Flux, Recon>* fk;
+  index_t cell, ia;
+  blocked_faces bf;
+  bool in;
+};
+
+/// The change F1 − F0 of the unblocked face between a (low) and b (high) along D when
+/// its face states are the one-sided values instead of the sweeps' (F0); the face's
+/// centre is b's low face on b's grid.
+template <int D, class Flux, class Recon>
+cons<double> neighbour_face_change(const stage_geometry& geo, const face_side<Flux, Recon>& a,
+                                   const face_side<Flux, Recon>& b) {
+  double la[5], ha[5], lb[5], hb[5], la1[5], ha1[5], lb1[5], hb1[5];
+  sweep_cell_faces<D>(*a.fk, a.cell, a.ia, la, ha);
+  sweep_cell_faces<D>(*b.fk, b.cell, b.ia, lb, hb);
+  one_sided_cell_faces<D>(*a.fk, a.bf, a.cell, a.ia, la1, ha1);
+  one_sided_cell_faces<D>(*b.fk, b.bf, b.cell, b.ia, lb1, hb1);
+  const auto& fk = *b.fk;
+  const vec3<double> n = geo.n[std::size_t(D)];
+  const double wn = face_speed(geo, D, face_centre(fk.grid, D, b.cell));
+  const cons<double> F0 = flux::ale_flux(fk.flux, prim_of(ha), prim_of(lb), n, wn, fk.gas);
+  const cons<double> F1 = flux::ale_flux(fk.flux, prim_of(ha1), prim_of(lb1), n, wn, fk.gas);
+  return {F1.rho - F0.rho, {F1.m.x - F0.m.x, F1.m.y - F0.m.y, F1.m.z - F0.m.z}, F1.E - F0.E};
+}
+
+/// Move a face's flux change dF between its cells' rates (global indices of dU; a side
+/// that is not `in` is left alone): dU_a −= dF/Δx_a, dU_b += dF/Δx_b.
+template <int D, class Flux, class Recon>
+void move_face_change(const cons<double>& dF, const face_side<Flux, Recon>& a, index_t ga,
+                      const face_side<Flux, Recon>& b, index_t gb, const fields5<double>& dU) {
+  const double d[5] = {dF.rho, dF.m.x, dF.m.y, dF.m.z, dF.E};
+  const double ixa = a.in ? a.fk->grid.inv_widths(D)[a.ia] : 0.0, ixb = b.in ? b.fk->grid.inv_widths(D)[b.ia] : 0.0;
+  for (int q = 0; q < 5; ++q) {
+    if (a.in) dU[q][ga] -= d[q] * ixa;
+    if (b.in) dU[q][gb] += d[q] * ixb;
+  }
+}
+
+/// Recompute the unblocked face between cells a (low, index ia along D) and a + s of the
+/// box with the one-sided values and move the difference to the sweeps' flux between the
+/// cells.
 template <int D, class Flux, class Recon>
 void correct_neighbour_face(const face_kernel<Flux, Recon>& fk, const stage_geometry& geo,
                             const std::vector<std::uint8_t>& blocked, index_t a, index_t ia,
                             const fields5<double>& dU) {
-  const rectilinear_grid& grid = fk.grid;
-  const index_t s = grid.stride(D), b = a + s;
-  double la[5], ha[5], lb[5], hb[5], la1[5], ha1[5], lb1[5], hb1[5];
-  sweep_cell_faces<D>(fk, a, ia, la, ha);
-  sweep_cell_faces<D>(fk, b, ia + 1, lb, hb);
-  blocked_cell_faces<D>(fk, blocked, a, ia, la1, ha1);
-  blocked_cell_faces<D>(fk, blocked, b, ia + 1, lb1, hb1);
-  const vec3<double> n = geo.n[std::size_t(D)];
-  const double wn = face_speed(geo, D, face_centre(grid, D, b));
-  const cons<double> F0 = flux::ale_flux(fk.flux, prim_of(ha), prim_of(lb), n, wn, fk.gas);
-  const cons<double> F1 = flux::ale_flux(fk.flux, prim_of(ha1), prim_of(lb1), n, wn, fk.gas);
-  const double dF[5] = {F1.rho - F0.rho, F1.m.x - F0.m.x, F1.m.y - F0.m.y, F1.m.z - F0.m.z, F1.E - F0.E};
-  const double* idx = grid.inv_widths(D);
-  const bool a_in = ia >= 0, b_in = ia + 1 < grid.n(D);
-  for (int q = 0; q < 5; ++q) {
-    if (a_in) dU[q][a] -= dF[q] * idx[ia];
-    if (b_in) dU[q][b] += dF[q] * idx[ia + 1];
-  }
+  const index_t s = fk.grid.stride(D), b = a + s;
+  const face_side<Flux, Recon> A{&fk, a, ia, blocked_along<D>(blocked, a, s), ia >= 0};
+  const face_side<Flux, Recon> B{&fk, b, ia + 1, blocked_along<D>(blocked, b, s), ia + 1 < fk.grid.n(D)};
+  move_face_change<D>(neighbour_face_change<D>(geo, A, B), A, a, B, b, dU);
 }
 
 /// fn(std::integral_constant<int, d>{}) for the run-time axis d.

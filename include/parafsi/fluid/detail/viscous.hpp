@@ -17,7 +17,7 @@
 /// along x (pointwise physics on V, scalar tail), each value with the operations of the
 /// scalar pass (Lanes = 1, kept as the reference) in the same order: the rotations reproduce
 /// Eigen's 3×3 product (rotate below), and the filter width Δ = (h_x h_y h_z)^{1/3} is
-/// std::cbrt lane by lane, reused along a row while h_x repeats. Without contraction of
+/// std::cbrt lane by lane, reused while the cell widths repeat. Without contraction of
 /// a b + c (-ffp-contract=off) packs, scalars and the stored-gradient form agree bit for bit;
 /// with it (the default where the hardware has FMA) the compiler fuses some sums differently
 /// in each: round-off.
@@ -153,15 +153,19 @@ struct viscous_pass {
     const double* hx = grid.widths(0);
     if constexpr (has_eddy_viscosity)
       par_for(threaded, -1, nz + 1, [&](index_t k) {
+        // Δ of the last cell, reused while its widths repeat (the same product, the same cube
+        // root): along a row, and from row to row on a uniform grid such as a block.
+        double hx_last = std::numeric_limits<double>::quiet_NaN(), hy_last = hx_last, hz_last = hx_last;
+        double delta_last = 0.0;
         for (index_t j = -1; j < ny + 1; ++j) {
           const index_t base = grid.index(0, j, k);
           const double inv_y = inv_gap(1, j), inv_z = inv_gap(2, k);
           const double hy = grid.width(1, j), hz = grid.width(2, k);
-          // Δ of the last cell along the row, reused while h_x repeats (the same product, the same cube root).
-          double h_last = std::numeric_limits<double>::quiet_NaN(), delta_last = 0.0;
           auto delta_at = [&](index_t i) {
-            if (!(hx[i] == h_last)) {
-              h_last = hx[i];
+            if (!(hx[i] == hx_last && hy == hy_last && hz == hz_last)) {
+              hx_last = hx[i];
+              hy_last = hy;
+              hz_last = hz;
               delta_last = std::cbrt(hx[i] * hy * hz);
             }
             return delta_last;

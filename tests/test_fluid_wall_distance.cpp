@@ -16,6 +16,37 @@
 
 using namespace parafsi;
 
+namespace {
+/// The cells of g (with `ghosts`, the ghost layers too) against a brute-force search over
+/// `pts`: cells within `reach` of a point, cells beyond, and cells whose value d differs
+/// (more than 1e-15 from the nearest distance, the same sum in another order; or not 1e30
+/// beyond the reach).
+struct brute_force_count {
+  int inside = 0, beyond = 0, wrong = 0;
+};
+brute_force_count compare_brute_force(const fluid::rectilinear_grid& g, const std::vector<Eigen::Vector3d>& pts,
+                                      double reach, const std::vector<double>& d, bool ghosts) {
+  const index_t ng = ghosts ? fluid::rectilinear_grid::ghosts : 0;
+  brute_force_count r;
+  for (index_t k = -ng; k < g.n(2) + ng; ++k)
+    for (index_t j = -ng; j < g.n(1) + ng; ++j)
+      for (index_t i = -ng; i < g.n(0) + ng; ++i) {
+        const Eigen::Vector3d x(g.centre(0, i), g.centre(1, j), g.centre(2, k));
+        double best = 1e300;
+        for (const auto& p : pts) best = std::min(best, (x - p).norm());
+        const double got = d[std::size_t(g.index(i, j, k))];
+        if (best <= reach) {
+          ++r.inside;
+          if (std::fabs(got - best) > 1e-15) ++r.wrong;
+        } else {
+          ++r.beyond;
+          if (got != 1e30) ++r.wrong;
+        }
+      }
+  return r;
+}
+}  // namespace
+
 TEST_CASE("wall distance: the nearest point within the reach, +inf beyond, as a brute-force search") {
   const auto g = fluid::rectilinear_grid{fluid::axis::refined(-1, 1, -0.3, 0.3, 0.05, 1.2),
                                          fluid::axis::uniform(20, -0.5, 0.5), fluid::axis::uniform(12, 0, 0.6)};
@@ -26,22 +57,7 @@ TEST_CASE("wall distance: the nearest point within the reach, +inf beyond, as a 
   const double reach = 0.2;
   std::vector<double> d(std::size_t(g.total_cells()), -7.0);
   fluid::distance_to_points(g, pts, reach, d);
-  int inside = 0, beyond = 0, wrong = 0;
-  for (index_t k = 0; k < g.n(2); ++k)
-    for (index_t j = 0; j < g.n(1); ++j)
-      for (index_t i = 0; i < g.n(0); ++i) {
-        const Eigen::Vector3d x(g.centre(0, i), g.centre(1, j), g.centre(2, k));
-        double best = 1e300;
-        for (const auto& p : pts) best = std::min(best, (x - p).norm());
-        const double got = d[std::size_t(g.index(i, j, k))];
-        if (best <= reach) {
-          ++inside;
-          if (std::fabs(got - best) > 1e-15) ++wrong;  // the same sum in another order
-        } else {
-          ++beyond;
-          if (got != 1e30) ++wrong;
-        }
-      }
+  const auto [inside, beyond, wrong] = compare_brute_force(g, pts, reach, d, false);
   MESSAGE(inside, " cells within the reach, ", beyond, " beyond, ", wrong, " differ");
   CHECK(inside > 100);
   CHECK(beyond > 100);
@@ -60,23 +76,7 @@ TEST_CASE("wall distance with ghosts: points outside the grid within and beyond 
   const double reach = 0.12;
   std::vector<double> d(std::size_t(g.total_cells()), -7.0);
   fluid::distance_to_points(g, pts, reach, d, true);
-  const index_t ng = fluid::rectilinear_grid::ghosts;
-  int inside = 0, beyond = 0, wrong = 0;
-  for (index_t k = -ng; k < g.n(2) + ng; ++k)
-    for (index_t j = -ng; j < g.n(1) + ng; ++j)
-      for (index_t i = -ng; i < g.n(0) + ng; ++i) {
-        const Eigen::Vector3d x(g.centre(0, i), g.centre(1, j), g.centre(2, k));
-        double best = 1e300;
-        for (const auto& p : pts) best = std::min(best, (x - p).norm());
-        const double got = d[std::size_t(g.index(i, j, k))];
-        if (best <= reach) {
-          ++inside;
-          if (std::fabs(got - best) > 1e-15) ++wrong;
-        } else {
-          ++beyond;
-          if (got != 1e30) ++wrong;
-        }
-      }
+  const auto [inside, beyond, wrong] = compare_brute_force(g, pts, reach, d, true);
   MESSAGE(inside, " cells (ghosts included) within the reach, ", beyond, " beyond, ", wrong, " differ");
   CHECK(inside > 100);
   CHECK(beyond > 10);

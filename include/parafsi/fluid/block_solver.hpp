@@ -808,8 +808,11 @@ class block_solver {
   struct cell_ref {
     index_t id, local, ia, global;
   };
-  /// The cell next to r along axis d (side 0: low, 1: high); stops the run where the
-  /// neighbour is a leaf of another level (a level boundary within the one-sided stencil).
+  /// The cell next to r along axis d (side 0: low, 1: high); stops the run where that
+  /// neighbour is a leaf of another level: the cells whose rates a one-sided patch corrects
+  /// (the face's two cells and the next one on each side) must be leaf cells of one level.
+  /// The two further cells the stencil reads come from the block's ghost layer, as the
+  /// sweeps read them (across a level boundary: prolonged or restricted values).
   cell_ref step_ref(const cell_ref& r, int d, int side) const {
     const block& b = blocks_[std::size_t(r.id)];
     auto ijk = b.grid.ijk(r.local);
@@ -819,7 +822,7 @@ class block_solver {
       const index_t g = neighbour(r.global, d, side);
       if (g >= 0) return {g / stride_, g % stride_, side ? 0 : n_ - 1, g};
       require(b.boundary[std::size_t(2 * d + side)], "fluid::block_solver: a level boundary (block ", r.id, ", axis ",
-              d, ") lies within the one-sided stencil of a membrane face: refine around the membrane");
+              d, ") lies next to the cells of a membrane face: refine around the membrane");
       return {r.id, b.grid.index(ijk[0], ijk[1], ijk[2]), ia, -1};
     }
     return {r.id, b.grid.index(ijk[0], ijk[1], ijk[2]), ia,

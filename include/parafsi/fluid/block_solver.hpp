@@ -35,6 +35,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -45,6 +46,7 @@
 #include "../core/soa.hpp"
 #include "blocks/exchange.hpp"
 #include "blocks/flux_correction.hpp"
+#include "blocks/halo.hpp"
 #include "blocks/layout.hpp"
 #include "blocks/refine.hpp"
 #include "blocks/tree.hpp"
@@ -315,13 +317,77 @@ class block_solver {
     return b.sponge ? b.sponge->template get<field::sponge_sigma>()[cell] : 0.0;
   }
 
-  /// Sums over leaf cells, blocks in tree order (bit-reproducible).
+  /// Sums over leaf cells: per block (its cells in order), then the blocks' sums in tree
+  /// order, so the result is the same bits on any number of processes (collective when
+  /// distributed).
   fluid::totals totals() const {
+    constexpr int w = 6;
+    std::vector<double> part(blocks_.size() * w, 0.0);
+    for (index_t id = first_; id < last_; ++id) {
+      const block& b = blocks_[std::size_t(id)];
+      fluid::totals t;
+      for (index_t k = 0; k < n_; ++k)
+        for (index_t j = 0; j < n_; ++j)
+          for (index_t i = 0; i < n_; ++i)
+            t.add(detail::load_cons(detail::conserved_ptrs(b.U), b.grid.index(i, j, k)), b.grid.cell_volume(i, j, k));
+      double* o = part.data() + std::size_t(id) * w;
+      o[0] = t.mass;
+      o[1] = t.momentum[0];
+      o[2] = t.momentum[1];
+      o[3] = t.momentum[2];
+      o[4] = t.energy;
+      o[5] = t.kinetic;
+    }
+    if (halo_) halo_->gather_blocks(part, w);
     fluid::totals t;
-    for_each_cell([&](const block& b, index_t i, index_t j, index_t k) {
-      t.add(detail::load_cons(detail::conserved_ptrs(b.U), b.grid.index(i, j, k)), b.grid.cell_volume(i, j, k));
-    });
+    for (std::size_t id = 0; id < blocks_.size(); ++id) {
+      const double* o = part.data() + id * w;
+      t.mass += o[0];
+      t.momentum[0] += o[1];
+      t.momentum[1] += o[2];
+      t.momentum[2] += o[3];
+      t.energy += o[4];
+      t.kinetic += o[5];
+    }
     return t;
+  }
+
+  // ------------------------------------------------------------------ distributed runs
+  /// Split the mesh over processes (blocks/halo.hpp; mpi/block_halo.hpp over MPI): from now
+  /// on this process computes only its blocks [first, last) and `h` brings what they read of
+  /// the others'. Every process must hold the same mesh and state when this is called, and
+  /// make the same calls after it (stepping, stable_dt, totals, regrid, gather). The others'
+  /// blocks are stale between `gather()` calls: call it before reading cells this process
+  /// does not own (sample, for_each_cell, output). Not yet: face patches (the couplings),
+  /// eddy-viscosity closures, checkpoints; these stop with a message.
+  void set_halo(std::shared_ptr<blocks::halo> h) {
+    if constexpr (has_eddy_viscosity)
+      require(h == nullptr, "fluid::block_solver::set_halo: eddy-viscosity closures do not run distributed yet");
+    halo_ = std::move(h);
+    first_ = 0;
+    last_ = block_count();
+    if (halo_) std::tie(first_, last_) = halo_->rebuild(mesh_view());
+  }
+  const blocks::halo* halo() const noexcept { return halo_.get(); }
+  /// The blocks this process computes: [first, last) of the tree order.
+  std::pair<index_t, index_t> owned_blocks() const noexcept { return {first_, last_}; }
+  /// Every block's interior cells from its owner to every process (collective; a no-op
+  /// when not distributed).
+  void gather() {
+    if (halo_) halo_->gather_state();
+  }
+  /// What a halo reads and writes: the tree, plans, corrections, storage and block costs.
+  blocks::mesh_view mesh_view() {
+    blocks::mesh_view m;
+    m.n = n_;
+    m.leaves = &tree_;
+    m.plan = &plan_;
+    m.corrections = &corrections_;
+    m.U = &U_all_;
+    m.registers.resize(blocks_.size());
+    m.weight.assign(blocks_.size(), 1.0);
+    for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces.data();
+    return m;
   }
 
   // ------------------------------------------------------------------ stepping
@@ -329,7 +395,7 @@ class block_solver {
   double stable_dt(double cfl = 0.5) const {
     require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt: CFL must be in (0, 1], got ", cfl);
     rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
-    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+    detail::par_for(threaded_, first_, last_, [&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
       const double* mu_t = nullptr;
       if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
@@ -337,7 +403,8 @@ class block_solver {
                                                                  visc_, turb_, mu_t, cfl, b.rate_slots, false);
     });
     double lam = 0.0;
-    for (double r : rate_) lam = std::max(lam, r);
+    for (index_t id = first_; id < last_; ++id) lam = std::max(lam, rate_[std::size_t(id)]);
+    if (halo_) lam = halo_->max(lam);  // exact: every process takes the same step
     require(std::isfinite(lam) && lam > 0.0, "fluid::block_solver::stable_dt: non-finite wave speed");
     return cfl / lam;
   }
@@ -406,6 +473,7 @@ class block_solver {
   /// included) and sources.
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& self) {
+    require(!self.halo_, "fluid::block_solver: checkpoints of a distributed mesh are not written yet");
     ar.check("type", self.name(), "the solver type");
     ar.check("ghosts", std::int64_t(ng), "the number of ghost layers");
     for (int d = 0; d < 3; ++d) {
@@ -458,7 +526,8 @@ class block_solver {
   /// a measure of how well the leaf resolves the vortical flow it holds (the wake); the
   /// input of blocks::leaf_indicator.
   std::vector<double> vorticity_indicator() {
-    fill_ghosts_all(t_);
+    gather();
+    fill_ghosts_all(t_, 0, block_count());
     std::vector<double> out(blocks_.size(), 0.0);
     detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
@@ -519,7 +588,8 @@ class block_solver {
       }
     }
     if (next.leaves() == tree_.leaves()) return false;
-    fill_ghosts_all(t_);  // the old mesh's ghosts feed the prolongation slopes
+    gather();  // a distributed mesh: every process moves every block (the mesh is replicated)
+    fill_ghosts_all(t_, 0, block_count());  // the old mesh's ghosts feed the prolongation slopes
     std::vector<block> old = std::move(blocks_);
     const std::unique_ptr<cons_storage> old_U = std::move(U_);  // the old blocks' slices point here
     const std::unique_ptr<turbulence_storage> old_T = std::move(T_);
@@ -622,6 +692,9 @@ class block_solver {
     U_all_.resize(nleaf);
     for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
+    first_ = 0;
+    last_ = index_t(nleaf);
+    if (halo_) std::tie(first_, last_) = halo_->rebuild(mesh_view());
   }
 
   void allocate_sources() {
@@ -645,7 +718,7 @@ class block_solver {
   void save_stage_start() {
     const index_t first = blocks::block_index{n_}(0, 0, 0);
     const index_t count = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1 - first;
-    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+    detail::par_for(threaded_, first_, last_, [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       const auto U = detail::conserved_ptrs(std::as_const(b.U));
       const auto U0 = detail::conserved_ptrs(b.U0);
@@ -666,8 +739,8 @@ class block_solver {
   void compute_rhs(double t, int stage, Patcher& patcher) {
     using detail::timed;
     const auto geo = detail::geometry(pose_);
-    const index_t nb = block_count();
-    timed(times_.boundaries, [&] { fill_ghosts_all(t); });
+    if (halo_) timed(times_.exchange, [&] { halo_->exchange_state(); });
+    timed(times_.boundaries, [&] { fill_ghosts_all(t, first_, last_); });
     // One buffer set per thread of the block loop, handed to the serial kernels inside.
     bufs_.resize(std::size_t(parallel::max_threads()));
     for (auto& set : bufs_) detail::ensure_row_buffers(set, n_);
@@ -678,7 +751,7 @@ class block_solver {
         if (vs.size() < cells) vs.resize(cells, 0.0);
     }
     timed(times_.fluxes, [&] {
-      detail::par_for(threaded_, 0, nb, [&](index_t id) {
+      detail::par_for(threaded_, first_, last_, [&](index_t id) {
         block& b = blocks_[std::size_t(id)];
         auto& bufs = bufs_[std::size_t(parallel::thread_id())];
         if constexpr (is_viscous)  // the viscous pass reads the whole ghost ring
@@ -695,11 +768,12 @@ class block_solver {
         detail::sweep<2>(fk, geo, dU, bufs, false, register_of(b, 2));
         if constexpr (is_viscous) add_viscous(b, geo, visc_bufs_[std::size_t(parallel::thread_id())]);
       });
-      detail::par_for(threaded_, 0, nb, [&](index_t id) { correct_fluxes(id); });
     });
+    if (halo_) timed(times_.exchange, [&] { halo_->exchange_registers(); });
+    timed(times_.fluxes, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { correct_fluxes(id); }); });
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
-      timed(times_.sources, [&] { detail::par_for(threaded_, 0, nb, [&](index_t id) { add_sources(id); }); });
+      timed(times_.sources, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { add_sources(id); }); });
   }
 
   /// The viscous and heat fluxes of block b (detail/viscous.hpp, on the block's grid with its
@@ -749,6 +823,7 @@ class block_solver {
   void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
     constexpr bool one_sided = detail::wants_one_sided<Patcher>() && Recon::second_order;
     const std::span<const patch_face> faces = patcher.patch_faces();
+    require(!halo_, "fluid::block_solver: face patches (the embedded coupling) do not run distributed yet");
     const fluid::view state = view();
     const auto dU = detail::conserved_ptrs(*dU_);
     for (std::size_t pi = 0; pi < faces.size(); ++pi) {
@@ -873,12 +948,11 @@ class block_solver {
   /// Every block's face ghosts from neighbours, then the box's boundary conditions; edge
   /// and corner ghosts only for the viscous pass (its cell gradients on the ghost ring read
   /// them), which the inviscid kernels never read.
-  void fill_ghosts_all(double t) {
+  void fill_ghosts_all(double t, index_t first, index_t last) {
     const auto geo = detail::geometry(pose_);
-    const index_t nb = block_count();
-    detail::par_for(threaded_, 0, nb,
+    detail::par_for(threaded_, first, last,
                     [&](index_t id) { blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_); });
-    detail::par_for(threaded_, 0, nb, [&](index_t id) {
+    detail::par_for(threaded_, first, last, [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       if (b.boundary != std::array<bool, 6>{})
         detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous);
@@ -1028,7 +1102,7 @@ class block_solver {
 
   void update(double a, double bcoef, double dt, double t_new, bool last) {
     detail::timed(times_.update, [&] {
-      detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+      detail::par_for(threaded_, first_, last_, [&](index_t id) {
         block& b = blocks_[std::size_t(id)];
         const auto U = detail::conserved_ptrs(b.U);
         const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
@@ -1037,8 +1111,10 @@ class block_solver {
         else detail::update<false>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
       });
       if (last)
-        for (auto& b : blocks_)
+        for (index_t id = first_; id < last_; ++id) {
+          const block& b = blocks_[std::size_t(id)];
           detail::check_rows(b.grid, gas_, pose_, detail::conserved_ptrs(std::as_const(b.U)), b.bad_rows.data(), t_new);
+        }
     });
   }
 
@@ -1073,6 +1149,8 @@ class block_solver {
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   phase_times times_{};
   bool threaded_ = false;
+  std::shared_ptr<blocks::halo> halo_;  ///< null: this process computes every block
+  index_t first_ = 0, last_ = 0;        ///< the blocks this process computes
 };
 
 template <policy... Ps>

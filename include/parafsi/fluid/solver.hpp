@@ -74,7 +74,8 @@ struct empty_storage {};
 /// Per-step phase timings (seconds, accumulated) for profiling.
 struct phase_times {
   double boundaries = 0, primitives = 0, fluxes = 0, viscous = 0, sources = 0, update = 0;
-  double total() const { return boundaries + primitives + fluxes + viscous + sources + update; }
+  double exchange = 0;  ///< messages between processes (a distributed block mesh)
+  double total() const { return boundaries + primitives + fluxes + viscous + sources + update + exchange; }
 };
 
 /// Totals over interior cells (inertial frame): mass, momentum, total energy.

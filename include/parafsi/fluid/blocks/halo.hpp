@@ -1,0 +1,158 @@
+/// \file halo.hpp
+/// What a block mesh split over several processes needs, without naming how the data
+/// travel (the MPI implementation is mpi/block_halo.hpp, behind its own target).
+///
+/// Every process keeps the whole tree, its exchange plans and flux corrections, and storage
+/// for every block (the mesh's metadata is small; the storage is replicated for now, see
+/// docs/guide_mpi.md), but computes only the blocks it owns: a contiguous range of the
+/// leaves' Morton order, cut by cost (`partition`). A stage of the block solver then reads
+/// three kinds of data another process computed:
+///   - the interior cells that its own blocks' ghost plans read (copies, restrictions and
+///     the prolongation stencils, blocks/exchange.hpp): `plan_reads` lists them;
+///   - the face-register entries of finer blocks that its coarse blocks' flux corrections
+///     read (blocks/flux_correction.hpp): `correction_reads`;
+///   - reductions: the stable step (a maximum, exact) and sums over the mesh, which are
+///     formed per block and added in block order on every process, so that they do not
+///     depend on the number of processes.
+/// Each block is computed by exactly one process with the serial kernels, and a value is
+/// moved, never recomputed, so a run gives the same bits on any number of processes.
+///
+/// References: Burstedde C., Wilcox L.C., Ghattas O. (2011) SIAM J. Sci. Comput. 33:1103
+///   (p4est: partition of the Morton order by weight); Stone J.M. et al. (2020) ApJS 249:4
+///   (Athena++: MeshBlocks distributed along the Z-order curve, boundary buffers per
+///   neighbour).
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "../../core/config.hpp"
+#include "../../core/error.hpp"
+#include "exchange.hpp"
+#include "flux_correction.hpp"
+#include "tree.hpp"
+
+namespace parafsi::fluid::blocks {
+
+/// The first block of each of `parts` processes (and the block count at the end): the
+/// leaves' order cut into contiguous ranges of nearly equal total weight (each cut where the
+/// running sum first reaches r/parts of the total). Every range is non-empty when there are
+/// at least as many blocks as parts.
+inline std::vector<index_t> partition(const std::vector<double>& weight, int parts) {
+  require(parts >= 1, "blocks::partition: need at least one part, got ", parts);
+  const index_t nb = index_t(weight.size());
+  double total = 0.0;
+  for (double w : weight) {
+    require(w > 0.0 && w < 1e300, "blocks::partition: block weights must be positive and finite");
+    total += w;
+  }
+  // prefix[b]: the weight of blocks [0, b); block b goes to the part its centre falls in.
+  std::vector<double> prefix(std::size_t(nb) + 1, 0.0);
+  for (index_t b = 0; b < nb; ++b) prefix[std::size_t(b + 1)] = prefix[std::size_t(b)] + weight[std::size_t(b)];
+  std::vector<index_t> start(std::size_t(parts) + 1, nb);
+  start[0] = 0;
+  index_t b = 0;
+  for (int r = 1; r < parts; ++r) {
+    const double goal = total * double(r) / double(parts);
+    while (b < nb && 0.5 * (prefix[std::size_t(b)] + prefix[std::size_t(b + 1)]) < goal) ++b;
+    // At least one block per part while there are enough of them.
+    const index_t lo = std::min(nb, start[std::size_t(r - 1)] + (nb >= parts ? 1 : 0));
+    const index_t hi = std::max(lo, nb - (nb >= parts ? index_t(parts - r) : 0));
+    b = std::clamp(b, lo, hi);
+    start[std::size_t(r)] = b;
+  }
+  return start;
+}
+
+/// A cell of a block (local flat index, ghosts included).
+struct cell_ref {
+  index_t block, cell;
+  friend auto operator<=>(const cell_ref&, const cell_ref&) = default;
+};
+
+/// Every cell of another block that the ghost plan of block `dst` reads, through f(cell_ref).
+template <class F>
+void plan_reads(const block_plan& p, index_t n, F&& f) {
+  constexpr index_t g = rectilinear_grid::ghosts;
+  const index_t sy = n + 2 * g, sz = sy * sy;
+  for (const auto& bx : p.copies)
+    for (index_t c = 0; c < bx.extent[2]; ++c)
+      for (index_t r = 0; r < bx.extent[1]; ++r)
+        for (index_t a = 0; a < bx.extent[0]; ++a) f(cell_ref{bx.src_block, bx.src + a + r * sy + c * sz});
+  auto eight = [&](index_t b, index_t c) {
+    for (index_t o : {index_t(0), index_t(1), sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1}) f(cell_ref{b, c + o});
+  };
+  for (const auto& it : p.restrictions) eight(it.src_block, it.src);
+  auto value = [&](const value_ref& v) {
+    if (v.block < 0) return;
+    if (v.restricted) eight(v.block, v.cell);
+    else f(cell_ref{v.block, v.cell});
+  };
+  for (const auto& grp : p.prolongations) {
+    value(grp.centre);
+    for (const auto& s : grp.side) value(s);
+  }
+}
+
+/// Values per face register of a block of n³ cells: [axis][side][component][n²].
+inline index_t register_size(index_t n) noexcept { return 3 * 2 * 5 * n * n; }
+
+/// Every register entry of a finer block that the flux corrections of coarse block `id`
+/// read, through f(cell_ref{fine block, offset in its register}).
+template <class F>
+void correction_reads(const std::vector<flux_correction>& fcs, index_t n, F&& f) {
+  const index_t n2 = n * n;
+  for (const auto& fc : fcs) {
+    const index_t side = 1 - fc.side;  // the fine block's face towards the coarse cell
+    for (index_t comp = 0; comp < 5; ++comp)
+      for (index_t face : fc.fine_face)
+        f(cell_ref{fc.fine_block, (index_t(fc.axis) * 10 + side * 5 + comp) * n2 + face});
+  }
+}
+
+/// What a halo reads and writes of a block mesh (block_solver::mesh_view()).
+struct mesh_view {
+  index_t n = 0;  ///< cells per block edge
+  const tree* leaves = nullptr;
+  const std::vector<block_plan>* plan = nullptr;
+  const std::vector<std::vector<flux_correction>>* corrections = nullptr;
+  const block_fields* U = nullptr;  ///< per block: its 5 conserved arrays (ghosts included)
+  std::vector<double*> registers;   ///< per block: its face register (register_size(n) values)
+  std::vector<double> weight;       ///< per block: its cost, for the partition
+};
+
+/// Message counters of a halo (its own bookkeeping, for the communication model).
+struct halo_counters {
+  std::int64_t messages = 0;   ///< point-to-point messages sent
+  std::int64_t bytes = 0;      ///< bytes in them
+  std::int64_t exchanges = 0;  ///< state exchanges (one per stage)
+};
+
+/// The interface the block solver calls at the points of a stage where another process's
+/// data are read (block_solver::set_halo). All calls are collective: every process makes
+/// them in the same order.
+class halo {
+ public:
+  virtual ~halo() = default;
+  /// The mesh is new (construction, regrid, restart): partition it and plan the messages;
+  /// returns the owned range [first, last) of block ids.
+  virtual std::pair<index_t, index_t> rebuild(const mesh_view& m) = 0;
+  /// Bring the cells the owned blocks' ghost plans read from their owners (before a stage).
+  virtual void exchange_state() = 0;
+  /// Bring the finer blocks' register entries the owned coarse blocks' corrections read.
+  virtual void exchange_registers() = 0;
+  /// Every block's interior cells to every process (before a regrid, a checkpoint, output).
+  virtual void gather_state() = 0;
+  /// The maximum of a value over the processes.
+  virtual double max(double local) = 0;
+  /// per_block holds `width` values per block, filled for the owned blocks: fill the rest
+  /// from their owners.
+  virtual void gather_blocks(std::vector<double>& per_block, int width) = 0;
+  /// This process's rank and the number of processes.
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  virtual halo_counters counters() const = 0;
+};
+
+}  // namespace parafsi::fluid::blocks

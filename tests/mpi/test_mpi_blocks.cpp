@@ -1,0 +1,206 @@
+// The block mesh over MPI (mpi/block_halo.hpp), run by CTest on 1, 2 and 4 processes:
+// a distributed run gives the bits of the same run on one process without a halo,
+// through coarse–fine faces, regrids, the viscous pass's edge ghosts, far-field
+// boundaries and the sponge; and the message counts the communication model uses.
+#define DOCTEST_CONFIG_IMPLEMENT
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include <parafsi/fluid/block_solver.hpp>
+#include <parafsi/fluid/reference/vortices.hpp>
+#include <parafsi/mpi/block_halo.hpp>
+#include <parafsi/parafsi.hpp>
+
+namespace pf = parafsi;
+namespace fluid = pf::fluid;
+namespace fb = pf::fluid::blocks;
+using pf::index_t;
+
+namespace {
+
+int world_rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+int world_size() {
+  int n = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+/// Refine the blocks whose box overlaps the sphere (centre, radius) up to max_level.
+fb::tree refined_tree(std::array<index_t, 3> nb, std::array<bool, 3> periodic, const fluid::block_layout& lay,
+                      const Eigen::Vector3d& centre, double radius, int max_level) {
+  fb::tree t(nb, periodic);
+  t.refine_where(max_level, [&](const fb::location& q) {
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double w = lay.block_width(d, q.level);
+      const double a = lay.lo[std::size_t(d)] + w * double(q.l[std::size_t(d)]), b = a + w;
+      const double c = std::clamp(centre[d], a, b) - centre[d];
+      d2 += c * c;
+    }
+    return d2 < radius * radius;
+  });
+  return t;
+}
+
+/// Every leaf cell's 5 conserved values, blocks in tree order.
+template <class S>
+std::vector<double> state_of(S& s) {
+  std::vector<double> out;
+  s.for_each_cell([&](const auto& b, index_t i, index_t j, index_t k) {
+    const index_t c = b.grid.index(i, j, k);
+    for (int f = 0; f < 5; ++f) out.push_back(b.U.data(std::size_t(f))[c]);
+  });
+  return out;
+}
+
+/// Cells whose values differ in any bit, over all processes (the same count everywhere).
+long mismatches(const std::vector<double>& a, const std::vector<double>& b) {
+  long bad = a.size() == b.size() ? 0 : long(std::max(a.size(), b.size()));
+  for (std::size_t i = 0; bad == 0 && i < a.size(); ++i) bad += a[i] != b[i] ? 1 : 0;
+  long all = 0;
+  MPI_Allreduce(&bad, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
+bool same_totals(const fluid::totals& a, const fluid::totals& b) {
+  return a.mass == b.mass && a.momentum == b.momentum && a.energy == b.energy && a.kinetic == b.kinetic;
+}
+
+}  // namespace
+
+TEST_CASE("partition: contiguous ranges of nearly equal weight, none empty") {
+  const auto s = fb::partition(std::vector<double>(10, 1.0), 4);
+  CHECK(s == std::vector<index_t>{0, 2, 5, 7, 10});  // cuts where the running weight passes 2.5, 5, 7.5
+  const auto w = fb::partition({1, 1, 1, 1, 8, 1, 1, 1}, 2);
+  CHECK(w == std::vector<index_t>{0, 4, 8});  // the heavy block's centre lies past half the total
+  const auto few = fb::partition({1, 1}, 4);
+  CHECK(few.front() == 0);
+  CHECK(few.back() == 2);
+  for (std::size_t r = 1; r < few.size(); ++r) CHECK(few[r] >= few[r - 1]);
+  CHECK_THROWS_AS(fb::partition({1.0, 0.0}, 2), pf::invalid_input);
+}
+
+TEST_CASE("distributed block mesh: a vortex through three levels and moving regrids, bit for bit") {
+  const int P = world_size();
+  fluid::block_layout lay{{0, 0, 0}, {10, 10, 2.5}, {4, 4, 1}, 8};
+  fluid::reference::isentropic_vortex v{};
+  v.cx = 3.0;
+  v.cy = 4.0;
+  v.u_inf = 2.0;
+  v.v_inf = 1.0;
+  v.period = 10.0;
+  const auto t0 = refined_tree({4, 4, 1}, {true, true, true}, lay, {3.0, 4.0, 1.25}, 1.2, 2);
+  auto make = [&] {
+    auto s = std::make_unique<fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::mc>>>(
+        t0, lay, pf::boundary::set::all(pf::boundary::periodic{}));
+    s->initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+    return s;
+  };
+  auto serial = make();
+  auto dist = make();
+  auto halo = std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD);
+  dist->set_halo(halo);
+  const auto [first, last] = dist->owned_blocks();
+  CHECK(last > first);
+  if (P > 1) CHECK(last - first < dist->block_count());  // this process computes only its share
+  // The refined region follows the vortex: level 2 within 1 of its centre, level 1 within 2.5.
+  auto target_of = [&](const auto& s) {
+    return [&](const fb::location& q) {
+      const double t = s.time();
+      const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
+      double d2 = 0;
+      for (int d = 0; d < 2; ++d) {
+        const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
+        double e = std::clamp(c[d], a, a + w) - c[d];
+        e -= 10.0 * std::round(e / 10.0);
+        d2 += e * e;
+      }
+      return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
+    };
+  };
+  int regrids = 0, dt_differ = 0;
+  const auto before = halo->counters();
+  for (int n = 0; n < 32; ++n) {
+    const double dts = serial->stable_dt(0.5), dtd = dist->stable_dt(0.5);
+    dt_differ += dts != dtd;
+    serial->step(dts);
+    dist->step(dtd);
+    if (n % 4 == 3) {
+      const bool a = serial->regrid(target_of(*serial), 2);
+      const bool b = dist->regrid(target_of(*dist), 2);
+      CHECK(a == b);
+      regrids += a;
+    }
+  }
+  const auto after = halo->counters();
+  dist->gather();
+  const long bad = mismatches(state_of(*serial), state_of(*dist));
+  if (world_rank() == 0)
+    MESSAGE(P, " processes: ", dist->block_count(), " blocks (levels 0-", dist->tree().finest_level(), "), ", regrids,
+            " regrids, ", (after.messages - before.messages) / std::max<long>(1, after.exchanges - before.exchanges),
+            " state+register messages and ",
+            double(after.bytes - before.bytes) / double(std::max<long>(1, after.exchanges - before.exchanges)),
+            " bytes per stage from rank 0; cells differing from one process: ", bad);
+  CHECK(regrids >= 2);
+  CHECK(dt_differ == 0);
+  CHECK(bad == 0);
+  CHECK(same_totals(serial->totals(), dist->totals()));
+  if (P > 1) CHECK(after.messages > before.messages);
+}
+
+TEST_CASE("distributed block mesh: viscous air, far field and sponge on a refined moving box, bit for bit") {
+  const double rho0 = 1.18, p0 = 101325.0;
+  fluid::block_layout box{{-1, -1, -1}, {1, 1, 1}, {2, 2, 2}, 8};
+  const auto t0 = refined_tree({2, 2, 2}, {false, false, false}, box, {0.2, -0.1, 0.3}, 0.3, 2);
+  pf::boundary::set bc = pf::boundary::set::all(pf::boundary::far_field{rho0, {30.0, 0.0, 0.0}, p0});
+  bc.layer.cells = 3;
+  pf::frame::rigid motion{Eigen::Vector3d(12.0, 16.0, 0.0), Eigen::Vector3d(0.6, 0.0, 0.8)};
+  auto make = [&] {
+    auto s = std::make_unique<fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::van_leer>,
+                                                  pf::turbulence::none, pf::viscosity::constant, pf::frame::rigid>>(
+        t0, box, bc, motion, pf::viscosity::constant{0.05, 0.72});
+    // A warm, dense blob off the refined region's centre: it crosses the level boundaries.
+    s->initialize([&](const Eigen::Vector3d& x) {
+      const double r2 = (x - Eigen::Vector3d(0.1, 0.0, 0.2)).squaredNorm();
+      return fluid::prim<double>{rho0 * (1.0 + 0.2 * std::exp(-r2 / 0.02)),
+                                 {30.0, 0.0, 0.0},
+                                 p0 * (1.0 + 0.3 * std::exp(-r2 / 0.02))};
+    });
+    return s;
+  };
+  auto serial = make();
+  auto dist = make();
+  dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  int dt_differ = 0;
+  for (int n = 0; n < 12; ++n) {
+    const double dts = serial->stable_dt(0.5), dtd = dist->stable_dt(0.5);
+    dt_differ += dts != dtd;
+    serial->step(dts);
+    dist->step(dtd);
+  }
+  dist->gather();
+  const long bad = mismatches(state_of(*serial), state_of(*dist));
+  if (world_rank() == 0)
+    MESSAGE(world_size(), " processes, ", dist->block_count(), " blocks: cells differing from one process: ", bad);
+  CHECK(dt_differ == 0);
+  CHECK(bad == 0);
+  CHECK(same_totals(serial->totals(), dist->totals()));
+}
+
+int main(int argc, char** argv) {
+  pf::mpi::environment env(argc, argv);
+  doctest::Context ctx(argc, argv);
+  if (world_rank() != 0) ctx.setOption("minimal", true);
+  int res = ctx.run();
+  int worst = 0;
+  MPI_Allreduce(&res, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return worst;
+}

@@ -364,9 +364,7 @@ class block_solver {
     if constexpr (has_eddy_viscosity)
       require(h == nullptr, "fluid::block_solver::set_halo: eddy-viscosity closures do not run distributed yet");
     halo_ = std::move(h);
-    first_ = 0;
-    last_ = block_count();
-    if (halo_) std::tie(first_, last_) = halo_->rebuild(mesh_view());
+    attach_halo();
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
   /// The blocks this process computes: [first, last) of the tree order.
@@ -692,9 +690,19 @@ class block_solver {
     U_all_.resize(nleaf);
     for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
+    attach_halo();
+  }
+
+  /// The owned range from the halo (all blocks without one), split into the blocks whose
+  /// ghosts are all local and those that read another process's cells.
+  void attach_halo() {
     first_ = 0;
-    last_ = index_t(nleaf);
+    last_ = block_count();
     if (halo_) std::tie(first_, last_) = halo_->rebuild(mesh_view());
+    local_ids_.clear();
+    remote_ids_.clear();
+    for (index_t id = first_; id < last_; ++id)
+      (halo_ && halo_->reads_remote(id) ? remote_ids_ : local_ids_).push_back(id);
   }
 
   void allocate_sources() {
@@ -739,8 +747,6 @@ class block_solver {
   void compute_rhs(double t, int stage, Patcher& patcher) {
     using detail::timed;
     const auto geo = detail::geometry(pose_);
-    if (halo_) timed(times_.exchange, [&] { halo_->exchange_state(); });
-    timed(times_.boundaries, [&] { fill_ghosts_all(t, first_, last_); });
     // One buffer set per thread of the block loop, handed to the serial kernels inside.
     bufs_.resize(std::size_t(parallel::max_threads()));
     for (auto& set : bufs_) detail::ensure_row_buffers(set, n_);
@@ -750,30 +756,45 @@ class block_solver {
       for (auto& vs : visc_bufs_)
         if (vs.size() < cells) vs.resize(cells, 0.0);
     }
-    timed(times_.fluxes, [&] {
-      detail::par_for(threaded_, first_, last_, [&](index_t id) {
-        block& b = blocks_[std::size_t(id)];
-        auto& bufs = bufs_[std::size_t(parallel::thread_id())];
-        if constexpr (is_viscous)  // the viscous pass reads the whole ghost ring
-          detail::compute_primitives(b.grid.total_cells(), gas_, detail::conserved_ptrs(std::as_const(b.U)),
-                                     detail::primitive_ptrs(b.W), false);
-        else
-          detail::compute_primitives_sweeps(b.grid, gas_, detail::conserved_ptrs(std::as_const(b.U)),
-                                            detail::primitive_ptrs(b.W));
-        const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
-                                                  detail::primitive_ptrs(std::as_const(b.W))};
-        const auto dU = detail::conserved_ptrs(b.dU);
-        detail::sweep<0>(fk, geo, dU, bufs, false, register_of(b, 0));
-        detail::sweep<1>(fk, geo, dU, bufs, false, register_of(b, 1));
-        detail::sweep<2>(fk, geo, dU, bufs, false, register_of(b, 2));
-        if constexpr (is_viscous) add_viscous(b, geo, visc_bufs_[std::size_t(parallel::thread_id())]);
+    // Ghosts, then the sweeps, of the owned blocks in `ids`.
+    auto ghosts_and_sweeps = [&](const std::vector<index_t>& ids) {
+      timed(times_.boundaries, [&] { fill_ghosts(t, ids); });
+      timed(times_.fluxes, [&] {
+        detail::par_for(threaded_, 0, index_t(ids.size()), [&](index_t k) { sweep_block(ids[std::size_t(k)], geo); });
       });
-    });
+    };
+    if (halo_) {  // the blocks with local ghosts while the messages travel, then the others
+      timed(times_.exchange, [&] { halo_->begin_state(); });
+      ghosts_and_sweeps(local_ids_);
+      timed(times_.exchange, [&] { halo_->end_state(); });
+      ghosts_and_sweeps(remote_ids_);
+    } else {
+      ghosts_and_sweeps(local_ids_);
+    }
     if (halo_) timed(times_.exchange, [&] { halo_->exchange_registers(); });
     timed(times_.fluxes, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { correct_fluxes(id); }); });
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
       timed(times_.sources, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { add_sources(id); }); });
+  }
+
+  /// Primitives and the three flux sweeps of block id (and its viscous pass), keeping its
+  /// boundary faces' fluxes in its face register.
+  void sweep_block(index_t id, const detail::stage_geometry& geo) {
+    block& b = blocks_[std::size_t(id)];
+    auto& bufs = bufs_[std::size_t(parallel::thread_id())];
+    if constexpr (is_viscous)  // the viscous pass reads the whole ghost ring
+      detail::compute_primitives(b.grid.total_cells(), gas_, detail::conserved_ptrs(std::as_const(b.U)),
+                                 detail::primitive_ptrs(b.W), false);
+    else
+      detail::compute_primitives_sweeps(b.grid, gas_, detail::conserved_ptrs(std::as_const(b.U)),
+                                        detail::primitive_ptrs(b.W));
+    const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid, detail::primitive_ptrs(std::as_const(b.W))};
+    const auto dU = detail::conserved_ptrs(b.dU);
+    detail::sweep<0>(fk, geo, dU, bufs, false, register_of(b, 0));
+    detail::sweep<1>(fk, geo, dU, bufs, false, register_of(b, 1));
+    detail::sweep<2>(fk, geo, dU, bufs, false, register_of(b, 2));
+    if constexpr (is_viscous) add_viscous(b, geo, visc_bufs_[std::size_t(parallel::thread_id())]);
   }
 
   /// The viscous and heat fluxes of block b (detail/viscous.hpp, on the block's grid with its
@@ -950,13 +971,20 @@ class block_solver {
   /// them), which the inviscid kernels never read.
   void fill_ghosts_all(double t, index_t first, index_t last) {
     const auto geo = detail::geometry(pose_);
-    detail::par_for(threaded_, first, last,
-                    [&](index_t id) { blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_); });
-    detail::par_for(threaded_, first, last, [&](index_t id) {
-      block& b = blocks_[std::size_t(id)];
-      if (b.boundary != std::array<bool, 6>{})
-        detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous);
-    });
+    detail::par_for(threaded_, first, last, [&](index_t id) { fill_block_ghosts(id, t, geo); });
+  }
+  void fill_ghosts(double t, const std::vector<index_t>& ids) {
+    const auto geo = detail::geometry(pose_);
+    detail::par_for(threaded_, 0, index_t(ids.size()),
+                    [&](index_t k) { fill_block_ghosts(ids[std::size_t(k)], t, geo); });
+  }
+  /// Block id's face ghosts from its plan (other blocks' interior cells only), then its box
+  /// boundary faces' conditions.
+  void fill_block_ghosts(index_t id, double t, const detail::stage_geometry& geo) {
+    blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_);
+    block& b = blocks_[std::size_t(id)];
+    if (b.boundary != std::array<bool, 6>{})
+      detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous);
   }
 
   /// Move the state of the old leaves onto the new ones (regrid).
@@ -1149,8 +1177,9 @@ class block_solver {
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   phase_times times_{};
   bool threaded_ = false;
-  std::shared_ptr<blocks::halo> halo_;  ///< null: this process computes every block
-  index_t first_ = 0, last_ = 0;        ///< the blocks this process computes
+  std::shared_ptr<blocks::halo> halo_;           ///< null: this process computes every block
+  index_t first_ = 0, last_ = 0;                 ///< the blocks this process computes
+  std::vector<index_t> local_ids_, remote_ids_;  ///< owned blocks whose ghosts are all local / read remote cells
 };
 
 template <policy... Ps>

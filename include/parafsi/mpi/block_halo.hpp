@@ -13,13 +13,15 @@
 /// (blocks::plan_reads) and the register entries its flux corrections read
 /// (blocks::correction_reads), sorted by (block, cell), so sender and receiver agree on the
 /// order without sending it. A state exchange is then one message per neighbouring rank
-/// each way (MPI_Irecv/MPI_Isend, then MPI_Waitall), the register exchange likewise; the
-/// reductions are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added
-/// in block order by the caller. Results are therefore bitwise those of one process.
+/// each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps
+/// the owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state)
+/// and the blocks that read remote cells, so the messages overlap that work. The register
+/// exchange is the same without overlap. The reductions are MPI_Allreduce (max, exact) and
+/// MPI_Allgatherv of per-block values, added in block order by the caller. Results are
+/// therefore bitwise those of one process.
 ///
-/// Not yet: overlapping the messages with interior work (the sweeps of blocks whose ghosts
-/// are all local could start before MPI_Waitall), storage for owned blocks and their
-/// neighbours only (every process holds every block's arrays), and a gather-free regrid.
+/// Not yet: storage for owned blocks and their neighbours only (every process holds every
+/// block's arrays), and a gather-free regrid.
 ///
 /// References: Message Passing Interface Forum (2021) MPI: A Message-Passing Interface
 ///   Standard, version 4.0 (non-blocking point-to-point, MPI_Allgatherv);
@@ -78,43 +80,38 @@ class block_halo final : public fluid::blocks::halo {
                 index_t(m_.weight.size()) == nb,
             "mpi::block_halo: incomplete mesh view");
     starts_ = fluid::blocks::partition(m_.weight, size_);
-    owner_.assign(std::size_t(nb), 0);
-    for (int r = 0; r < size_; ++r)
-      for (index_t b = starts_[std::size_t(r)]; b < starts_[std::size_t(r) + 1]; ++b) owner_[std::size_t(b)] = r;
-    state_send_.assign(std::size_t(size_), {});
-    state_recv_.assign(std::size_t(size_), {});
-    reg_send_.assign(std::size_t(size_), {});
-    reg_recv_.assign(std::size_t(size_), {});
-    for (index_t b = 0; b < nb; ++b) {
-      const int dst = owner_[std::size_t(b)];
-      auto noter = [&](lists* send, lists* recv) {
-        return [this, send, recv, dst](const cell_ref& c) {
-          const int src = owner_[std::size_t(c.block)];
-          if (src == dst) return;
-          if (src == rank_) (*send)[std::size_t(dst)].push_back(c);
-          if (dst == rank_) (*recv)[std::size_t(src)].push_back(c);
-        };
-      };
-      fluid::blocks::plan_reads((*m_.plan)[std::size_t(b)], m_.n, noter(&state_send_, &state_recv_));
-      fluid::blocks::correction_reads((*m_.corrections)[std::size_t(b)], m_.n, noter(&reg_send_, &reg_recv_));
-    }
-    for (lists* l : {&state_send_, &state_recv_, &reg_send_, &reg_recv_})
-      for (auto& v : *l) {
-        std::sort(v.begin(), v.end());
-        v.erase(std::unique(v.begin(), v.end()), v.end());
+    owner_ = fluid::blocks::owners(starts_);
+    // This process's part of the whole mesh's transfers, already sorted by (peer, block, cell).
+    const auto [state, regs] = fluid::blocks::plan_transfers(*m_.plan, *m_.corrections, m_.n, starts_);
+    auto split = [&](const std::vector<fluid::blocks::transfer>& all, lists& send, lists& recv) {
+      send.assign(std::size_t(size_), {});
+      recv.assign(std::size_t(size_), {});
+      for (const auto& t : all) {
+        if (t.from == rank_) send[std::size_t(t.to)].push_back(t.what);
+        if (t.to == rank_) recv[std::size_t(t.from)].push_back(t.what);
       }
+    };
+    split(state, state_send_, state_recv_);
+    split(regs, reg_send_, reg_recv_);
+    remote_reader_.assign(std::size_t(nb), 0);
+    for (index_t b = starts_[std::size_t(rank_)]; b < starts_[std::size_t(rank_) + 1]; ++b)
+      fluid::blocks::plan_reads((*m_.plan)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
+        if (owner_[std::size_t(c.block)] != rank_) remote_reader_[std::size_t(b)] = 1;
+      });
     return {starts_[std::size_t(rank_)], starts_[std::size_t(rank_) + 1]};
   }
 
-  void exchange_state() override {
-    exchange(state_send_, state_recv_, 5,
-             [this](const cell_ref& c, int f) -> double& { return (*m_.U)[std::size_t(c.block)][f][c.cell]; });
+  void begin_state() override {
+    begin(state_send_, state_recv_, 5, state_at{this});
     ++count_.exchanges;
   }
+  void end_state() override { end(state_recv_, 5, state_at{this}); }
+  bool reads_remote(index_t id) const override { return remote_reader_[std::size_t(id)] != 0; }
 
   void exchange_registers() override {
-    exchange(reg_send_, reg_recv_, 1,
-             [this](const cell_ref& c, int) -> double& { return m_.registers[std::size_t(c.block)][c.cell]; });
+    auto at = [this](const cell_ref& c, int) -> double& { return m_.registers[std::size_t(c.block)][c.cell]; };
+    begin(reg_send_, reg_recv_, 1, at);
+    end(reg_recv_, 1, at);
   }
 
   void gather_state() override {
@@ -171,10 +168,16 @@ class block_halo final : public fluid::blocks::halo {
     }
     return {counts, displs};
   }
-  /// One message per peer each way: receive, pack and send, wait, unpack. width values
-  /// per listed item, at(item, k) the storage of value k.
+  /// The conserved value f of a cell (the state exchange's storage).
+  struct state_at {
+    const block_halo* h;
+    double& operator()(const cell_ref& c, int f) const { return (*h->m_.U)[std::size_t(c.block)][f][c.cell]; }
+  };
+
+  /// One message per peer each way: post the receives, pack and send (begin); wait and
+  /// unpack (end). width values per listed item, at(item, k) the storage of value k.
   template <class At>
-  void exchange(const lists& send, const lists& recv, int width, At&& at) {
+  void begin(const lists& send, const lists& recv, int width, At&& at) {
     sbuf_.resize(std::size_t(size_));
     rbuf_.resize(std::size_t(size_));
     reqs_.clear();
@@ -199,7 +202,11 @@ class block_halo final : public fluid::blocks::halo {
       ++count_.messages;
       count_.bytes += std::int64_t(buf.size() * sizeof(double));
     }
+  }
+  template <class At>
+  void end(const lists& recv, int width, At&& at) {
     MPI_Waitall(int(reqs_.size()), reqs_.data(), MPI_STATUSES_IGNORE);
+    reqs_.clear();
     for (int r = 0; r < size_; ++r) {
       const auto& items = recv[std::size_t(r)];
       const auto& buf = rbuf_[std::size_t(r)];
@@ -215,6 +222,7 @@ class block_halo final : public fluid::blocks::halo {
   fluid::blocks::mesh_view m_;
   std::vector<index_t> starts_;
   std::vector<int> owner_;
+  std::vector<char> remote_reader_;  ///< per block: its ghost plan reads another process's cells
   lists state_send_, state_recv_, reg_send_, reg_recv_;
   std::vector<std::vector<double>> sbuf_, rbuf_;
   std::vector<double> gather_;

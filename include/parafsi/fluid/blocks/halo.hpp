@@ -111,6 +111,50 @@ void correction_reads(const std::vector<flux_correction>& fcs, index_t n, F&& f)
   }
 }
 
+/// The owner of each block for the partition `starts` (blocks [starts[r], starts[r + 1]) on r).
+inline std::vector<int> owners(const std::vector<index_t>& starts) {
+  std::vector<int> out(std::size_t(starts.back()), 0);
+  for (std::size_t r = 0; r + 1 < starts.size(); ++r)
+    for (index_t b = starts[r]; b < starts[r + 1]; ++b) out[std::size_t(b)] = int(r);
+  return out;
+}
+
+/// One value that travels between two processes in a stage: `what` (a cell or a register
+/// entry) from process `from`, which owns its block, to process `to`, which reads it.
+struct transfer {
+  int from, to;
+  cell_ref what;
+  friend auto operator<=>(const transfer&, const transfer&) = default;
+};
+
+/// Every cell (state exchange) or register entry (flux correction) that crosses between
+/// processes in a stage for the partition `starts`, sorted by (from, to, block, cell) and
+/// without repeats: the exchange lists of every process at once (a process sends the
+/// entries with from == its rank, grouped by `to`, and receives those with to == its rank),
+/// and the communication model's counts (bench/halo_model.cpp).
+inline std::pair<std::vector<transfer>, std::vector<transfer>> plan_transfers(
+    const std::vector<block_plan>& plan, const std::vector<std::vector<flux_correction>>& corrections, index_t n,
+    const std::vector<index_t>& starts) {
+  const std::vector<int> own = owners(starts);
+  std::vector<transfer> state, regs;
+  for (std::size_t b = 0; b < plan.size(); ++b) {
+    const int to = own[b];
+    auto note = [&](std::vector<transfer>& out) {
+      return [&, to](const cell_ref& c) {
+        const int from = own[std::size_t(c.block)];
+        if (from != to) out.push_back({from, to, c});
+      };
+    };
+    plan_reads(plan[b], n, note(state));
+    correction_reads(corrections[b], n, note(regs));
+  }
+  for (auto* v : {&state, &regs}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  return {std::move(state), std::move(regs)};
+}
+
 /// What a halo reads and writes of a block mesh (block_solver::mesh_view()).
 struct mesh_view {
   index_t n = 0;  ///< cells per block edge
@@ -138,8 +182,14 @@ class halo {
   /// The mesh is new (construction, regrid, restart): partition it and plan the messages;
   /// returns the owned range [first, last) of block ids.
   virtual std::pair<index_t, index_t> rebuild(const mesh_view& m) = 0;
-  /// Bring the cells the owned blocks' ghost plans read from their owners (before a stage).
-  virtual void exchange_state() = 0;
+  /// Bring the cells the owned blocks' ghost plans read from their owners (before a stage),
+  /// in two halves: begin_state() starts the messages, end_state() waits for them and
+  /// stores the cells; between the two the solver works on the blocks that read no other
+  /// process's cells (reads_remote(id) false).
+  virtual void begin_state() = 0;
+  virtual void end_state() = 0;
+  /// Whether the ghost plan of owned block `id` reads cells of another process.
+  virtual bool reads_remote(index_t id) const = 0;
   /// Bring the finer blocks' register entries the owned coarse blocks' corrections read.
   virtual void exchange_registers() = 0;
   /// Every block's interior cells to every process (before a regrid, a checkpoint, output).

@@ -1,17 +1,21 @@
 // The block mesh over MPI (mpi/block_halo.hpp), run by CTest on 1, 2 and 4 processes:
 // a distributed run gives the bits of the same run on one process without a halo,
 // through coarse–fine faces, regrids, the viscous pass's edge ghosts, far-field
-// boundaries and the sponge; and the message counts the communication model uses.
+// boundaries, the sponge and an eddy-viscosity closure; a checkpoint written by some of
+// the processes restarts on one and on all of them bit for bit.
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <parafsi/fluid/block_solver.hpp>
 #include <parafsi/fluid/reference/vortices.hpp>
+#include <parafsi/io/checkpoint.hpp>
 #include <parafsi/mpi/block_halo.hpp>
 #include <parafsi/parafsi.hpp>
 
@@ -193,6 +197,137 @@ TEST_CASE("distributed block mesh: viscous air, far field and sponge on a refine
   CHECK(dt_differ == 0);
   CHECK(bad == 0);
   CHECK(same_totals(serial->totals(), dist->totals()));
+}
+
+namespace {
+/// The periodic vortex of the first case on three static levels, with `Policies`.
+struct vortex_case {
+  fluid::block_layout lay{{0, 0, 0}, {10, 10, 2.5}, {4, 4, 1}, 8};
+  fluid::reference::isentropic_vortex v{};
+  fb::tree t0;
+  vortex_case() {
+    v.cx = 3.0;
+    v.cy = 4.0;
+    v.u_inf = 2.0;
+    v.v_inf = 1.0;
+    v.period = 10.0;
+    t0 = refined_tree({4, 4, 1}, {true, true, true}, lay, {3.0, 4.0, 1.25}, 1.2, 2);
+  }
+  template <class Solver, class... Ps>
+  std::unique_ptr<Solver> make(const Ps&... ps) const {
+    auto s = std::make_unique<Solver>(t0, lay, pf::boundary::set::all(pf::boundary::periodic{}), ps...);
+    s->initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+    return s;
+  }
+  /// Level 2 on the blocks at the vortex's start, level 1 around: a regrid that changes the mesh.
+  int target(const fb::location& q) const {
+    const Eigen::Vector3d c(4.0, 4.5, 1.25);
+    double d2 = 0;
+    for (int d = 0; d < 2; ++d) {
+      const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
+      const double e = std::clamp(c[d], a, a + w) - c[d];
+      d2 += e * e;
+    }
+    return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
+  }
+};
+}  // namespace
+
+TEST_CASE("distributed block mesh: Smagorinsky eddy viscosity through levels and a regrid, bit for bit") {
+  using S = fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::van_leer>, pf::turbulence::smagorinsky,
+                                pf::viscosity::constant>;
+  const vortex_case vc;
+  const pf::viscosity::constant air{0.02, 0.72};  // a viscous vortex: μ_t and μ both matter
+  auto serial = vc.make<S>(pf::turbulence::smagorinsky{}, air);
+  auto dist = vc.make<S>(pf::turbulence::smagorinsky{}, air);
+  dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  int dt_differ = 0;
+  for (int n = 0; n < 10; ++n) {
+    const double dts = serial->stable_dt(0.5), dtd = dist->stable_dt(0.5);
+    dt_differ += dts != dtd;
+    serial->step(dts);
+    dist->step(dtd);
+    if (n == 4)
+      CHECK(serial->regrid([&](const fb::location& q) { return vc.target(q); }, 2) ==
+            dist->regrid([&](const fb::location& q) { return vc.target(q); }, 2));
+  }
+  dist->gather();
+  const long bad = mismatches(state_of(*serial), state_of(*dist));
+  double mu_max = 0;
+  long mu_bad = 0;
+  for (index_t b = 0; b < serial->block_count(); ++b)
+    for (index_t k = 0; k < 8; ++k)
+      for (index_t j = 0; j < 8; ++j)
+        for (index_t i = 0; i < 8; ++i) {
+          const index_t c = serial->block_at(b).grid.index(i, j, k);
+          const double a = serial->eddy_viscosity()[serial->global_index(b, c)];
+          mu_max = std::max(mu_max, a);
+          mu_bad += a != dist->eddy_viscosity()[dist->global_index(b, c)];
+        }
+  if (world_rank() == 0)
+    MESSAGE(world_size(), " processes, Smagorinsky: cells differing ", bad, ", eddy viscosities differing ", mu_bad,
+            " (max mu_t ", mu_max, " Pa s)");
+  CHECK(dt_differ == 0);
+  CHECK(bad == 0);
+  CHECK(mu_bad == 0);
+  CHECK(mu_max > 0.0);
+}
+
+TEST_CASE("distributed checkpoint: written by half the processes, restarted on one and on all, bit for bit") {
+  using S = fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::mc>>;
+  const int P = world_size(), writers = (P + 1) / 2;
+  const vortex_case vc;
+  const auto path = std::filesystem::temp_directory_path() / ("parafsi_test_mpi_np" + std::to_string(P) + ".ckpt");
+  auto regrid = [&](S& s) { return s.regrid([&](const fb::location& q) { return vc.target(q); }, 2); };
+  // The reference: one process, 6 steps, a regrid, 6 more.
+  auto ref = vc.make<S>();
+  for (int n = 0; n < 6; ++n) ref->step(ref->stable_dt(0.5));
+  CHECK(regrid(*ref));
+  // The writers: the first ⌈P/2⌉ processes run the first part distributed and write.
+  MPI_Comm wcomm = MPI_COMM_NULL;
+  MPI_Comm_split(MPI_COMM_WORLD, world_rank() < writers ? 0 : MPI_UNDEFINED, world_rank(), &wcomm);
+  if (wcomm != MPI_COMM_NULL) {
+    auto w = vc.make<S>();
+    w->set_halo(std::make_shared<pf::mpi::block_halo>(wcomm));
+    for (int n = 0; n < 6; ++n) w->step(w->stable_dt(0.5));
+    regrid(*w);
+    w->gather();
+    int wrank = 0;
+    MPI_Comm_rank(wcomm, &wrank);
+    if (wrank == 0) pf::io::save_checkpoint(path, *w);
+    // Not gathered since the last step: writing is refused with a message.
+    w->step(w->stable_dt(0.5));
+    CHECK_THROWS_AS(pf::io::save_checkpoint(path.string() + ".late", *w), pf::error);
+    MPI_Comm_free(&wcomm);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  // The readers: one process (no halo), and all P processes.
+  auto one = vc.make<S>();
+  pf::io::load_checkpoint(path, *one);
+  auto all = vc.make<S>();
+  pf::io::load_checkpoint(path, *all);
+  all->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  int dt_differ = 0;
+  for (int n = 0; n < 6; ++n) {
+    const double dt = ref->stable_dt(0.5);
+    dt_differ += (one->stable_dt(0.5) != dt) + (all->stable_dt(0.5) != dt);
+    ref->step(dt);
+    one->step(dt);
+    all->step(dt);
+  }
+  all->gather();
+  const auto r = state_of(*ref);
+  const long bad_one = mismatches(r, state_of(*one)), bad_all = mismatches(r, state_of(*all));
+  if (world_rank() == 0)
+    MESSAGE("written by ", writers, " of ", P, " processes (", ref->block_count(), " blocks), restarted on 1 and on ",
+            P, ": cells differing ", bad_one, " and ", bad_all);
+  CHECK(dt_differ == 0);
+  CHECK(bad_one == 0);
+  CHECK(bad_all == 0);
+  CHECK(one->time() == ref->time());
+  CHECK(all->steps() == ref->steps());
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (world_rank() == 0) std::filesystem::remove(path);
 }
 
 int main(int argc, char** argv) {

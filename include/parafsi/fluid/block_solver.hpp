@@ -358,12 +358,14 @@ class block_solver {
   /// the others'. Every process must hold the same mesh and state when this is called, and
   /// make the same calls after it (stepping, stable_dt, totals, regrid, gather). The others'
   /// blocks are stale between `gather()` calls: call it before reading cells this process
-  /// does not own (sample, for_each_cell, output). Not yet: face patches (the couplings),
-  /// eddy-viscosity closures, checkpoints; these stop with a message.
+  /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
+  /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
+  /// Not yet: face patches (the embedded coupling) stop with a message. With an
+  /// eddy-viscosity closure the wall distance is the caller's, on every block, as without
+  /// a halo.
   void set_halo(std::shared_ptr<blocks::halo> h) {
-    if constexpr (has_eddy_viscosity)
-      require(h == nullptr, "fluid::block_solver::set_halo: eddy-viscosity closures do not run distributed yet");
     halo_ = std::move(h);
+    gathered_ = true;  // the caller's promise: every process holds the same state
     attach_halo();
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
@@ -373,6 +375,7 @@ class block_solver {
   /// when not distributed).
   void gather() {
     if (halo_) halo_->gather_state();
+    gathered_ = true;
   }
   /// What a halo reads and writes: the tree, plans, corrections, storage and block costs.
   blocks::mesh_view mesh_view() {
@@ -385,6 +388,10 @@ class block_solver {
     m.registers.resize(blocks_.size());
     m.weight.assign(blocks_.size(), 1.0);
     for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces.data();
+    if constexpr (has_eddy_viscosity) {
+      m.mu_t.resize(blocks_.size());
+      for (std::size_t id = 0; id < blocks_.size(); ++id) m.mu_t[id] = blocks_[id].T.template get<field::mu_t>();
+    }
     return m;
   }
 
@@ -419,6 +426,7 @@ class block_solver {
   template <face_patcher Patcher>
   void step(double dt, const frame::motion& m, Patcher& patcher) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
+    gathered_ = !halo_;
     pose_.set_motion(m);
     save_stage_start();
     double pose_time = 0.0;
@@ -471,7 +479,9 @@ class block_solver {
   /// included) and sources.
   template <class Archive, class Self>
   static void serialize(Archive& ar, Self& self) {
-    require(!self.halo_, "fluid::block_solver: checkpoints of a distributed mesh are not written yet");
+    if constexpr (!Archive::loading)
+      require(!self.halo_ || self.gathered_,
+              "fluid::block_solver: a distributed mesh is written after gather() (every process), from one process");
     ar.check("type", self.name(), "the solver type");
     ar.check("ghosts", std::int64_t(ng), "the number of ghost layers");
     for (int d = 0; d < 3; ++d) {
@@ -1178,6 +1188,7 @@ class block_solver {
   phase_times times_{};
   bool threaded_ = false;
   std::shared_ptr<blocks::halo> halo_;           ///< null: this process computes every block
+  bool gathered_ = true;                         ///< every block's state is current on this process (set by gather())
   index_t first_ = 0, last_ = 0;                 ///< the blocks this process computes
   std::vector<index_t> local_ids_, remote_ids_;  ///< owned blocks whose ghosts are all local / read remote cells
 };

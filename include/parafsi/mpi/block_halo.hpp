@@ -115,7 +115,9 @@ class block_halo final : public fluid::blocks::halo {
   }
 
   void gather_state() override {
-    const index_t n = m_.n, per = 5 * n * n * n;
+    const index_t n = m_.n;
+    const int fields = m_.mu_t.empty() ? 5 : 6;  // the conserved state, and μ_t with a closure
+    const index_t per = fields * n * n * n;
     const fluid::blocks::block_index at{n};
     const auto [counts, displs] = layout(per);
     const index_t nb = starts_.back();
@@ -123,8 +125,8 @@ class block_halo final : public fluid::blocks::halo {
     gather_.resize(std::size_t(per * nb));
     auto each = [&](index_t b, auto&& f) {
       double* o = gather_.data() + per * b;
-      for (int q = 0; q < 5; ++q) {
-        double* u = (*m_.U)[std::size_t(b)][q];
+      for (int q = 0; q < fields; ++q) {
+        double* u = q < 5 ? (*m_.U)[std::size_t(b)][q] : m_.mu_t[std::size_t(b)];
         for (index_t k = 0; k < n; ++k)
           for (index_t j = 0; j < n; ++j)
             for (index_t i = 0; i < n; ++i) f(*o++, u[at(i, j, k)]);

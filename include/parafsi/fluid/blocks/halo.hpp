@@ -163,6 +163,7 @@ struct mesh_view {
   const std::vector<std::vector<flux_correction>>* corrections = nullptr;
   const block_fields* U = nullptr;  ///< per block: its 5 conserved arrays (ghosts included)
   std::vector<double*> registers;   ///< per block: its face register (register_size(n) values)
+  std::vector<double*> mu_t;        ///< per block: its eddy viscosity (none without a closure)
   std::vector<double> weight;       ///< per block: its cost, for the partition
 };
 
@@ -192,7 +193,8 @@ class halo {
   virtual bool reads_remote(index_t id) const = 0;
   /// Bring the finer blocks' register entries the owned coarse blocks' corrections read.
   virtual void exchange_registers() = 0;
-  /// Every block's interior cells to every process (before a regrid, a checkpoint, output).
+  /// Every block's interior cells (and eddy viscosity, with a closure) to every process
+  /// (before a regrid, a checkpoint, output).
   virtual void gather_state() = 0;
   /// The maximum of a value over the processes.
   virtual double max(double local) = 0;

@@ -89,8 +89,7 @@ int main(int argc, char** argv) {
   double mine[3] = {msgs, bytes, xsec}, mx[3], sum[3];
   MPI_Reduce(mine, mx, 3, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   MPI_Reduce(mine, sum, 3, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-  const auto [first, last] = s->owned_blocks();
-  long owned = long(last - first), most = 0;
+  long owned = long(s->computed_blocks().size()), most = 0;
   MPI_Reduce(&owned, &most, 1, MPI_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
   long bad = -1;
   if (check) {

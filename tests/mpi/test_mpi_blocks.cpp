@@ -112,9 +112,9 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
   auto dist = make();
   auto halo = std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD);
   dist->set_halo(halo);
-  const auto [first, last] = dist->owned_blocks();
-  CHECK(last > first);
-  if (P > 1) CHECK(last - first < dist->block_count());  // this process computes only its share
+  const auto owned = index_t(dist->computed_blocks().size());
+  CHECK(owned > 0);
+  if (P > 1) CHECK(owned < dist->block_count());  // this process computes only its share
   // The refined region follows the vortex: level 2 within 1 of its centre, level 1 within 2.5.
   auto target_of = [&](const auto& s) {
     return [&](const fb::location& q) {

@@ -323,7 +323,7 @@ class block_solver {
   fluid::totals totals() const {
     constexpr int w = 6;
     std::vector<double> part(blocks_.size() * w, 0.0);
-    for (index_t id = first_; id < last_; ++id) {
+    for (index_t id : computed_) {
       const block& b = blocks_[std::size_t(id)];
       fluid::totals t;
       for (index_t k = 0; k < n_; ++k)
@@ -360,7 +360,9 @@ class block_solver {
   /// blocks are stale between `gather()` calls: call it before reading cells this process
   /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
   /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
-  /// Not yet: face patches (the embedded coupling) stop with a message. With an
+  /// A coupling reads and writes cells near the structure: the blocks it touches must be
+  /// computed by every process (mpi::block_halo's replicate_finest, with the structure on
+  /// the finest level); a patched face elsewhere stops with a message. With an
   /// eddy-viscosity closure the wall distance is the caller's, on every block, as without
   /// a halo.
   void set_halo(std::shared_ptr<blocks::halo> h) {
@@ -370,7 +372,8 @@ class block_solver {
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
   /// The blocks this process computes: [first, last) of the tree order.
-  std::pair<index_t, index_t> owned_blocks() const noexcept { return {first_, last_}; }
+  /// The blocks this process computes (tree order): all without a halo.
+  const std::vector<index_t>& computed_blocks() const noexcept { return computed_; }
   /// Every block's interior cells from its owner to every process (collective; a no-op
   /// when not distributed).
   void gather() {
@@ -400,7 +403,7 @@ class block_solver {
   double stable_dt(double cfl = 0.5) const {
     require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt: CFL must be in (0, 1], got ", cfl);
     rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
-    detail::par_for(threaded_, first_, last_, [&](index_t id) {
+    for_computed([&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
       const double* mu_t = nullptr;
       if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
@@ -408,7 +411,7 @@ class block_solver {
                                                                  visc_, turb_, mu_t, cfl, b.rate_slots, false);
     });
     double lam = 0.0;
-    for (index_t id = first_; id < last_; ++id) lam = std::max(lam, rate_[std::size_t(id)]);
+    for (index_t id : computed_) lam = std::max(lam, rate_[std::size_t(id)]);
     if (halo_) lam = halo_->max(lam);  // exact: every process takes the same step
     require(std::isfinite(lam) && lam > 0.0, "fluid::block_solver::stable_dt: non-finite wave speed");
     return cfl / lam;
@@ -703,16 +706,24 @@ class block_solver {
     attach_halo();
   }
 
-  /// The owned range from the halo (all blocks without one), split into the blocks whose
-  /// ghosts are all local and those that read another process's cells.
+  /// The blocks this process computes, from the halo (all without one), split into those
+  /// whose ghosts are all local and those that read another process's cells.
   void attach_halo() {
-    first_ = 0;
-    last_ = block_count();
-    if (halo_) std::tie(first_, last_) = halo_->rebuild(mesh_view());
+    computed_.clear();
+    if (halo_) computed_ = halo_->rebuild(mesh_view());
+    else
+      for (index_t id = 0; id < block_count(); ++id) computed_.push_back(id);
+    computes_.assign(blocks_.size(), 0);
+    for (index_t id : computed_) computes_[std::size_t(id)] = 1;
     local_ids_.clear();
     remote_ids_.clear();
-    for (index_t id = first_; id < last_; ++id)
-      (halo_ && halo_->reads_remote(id) ? remote_ids_ : local_ids_).push_back(id);
+    for (index_t id : computed_) (halo_ && halo_->reads_remote(id) ? remote_ids_ : local_ids_).push_back(id);
+  }
+
+  /// f(id) for every block this process computes, in parallel over blocks.
+  template <class F>
+  void for_computed(F&& f) const {
+    detail::par_for(threaded_, 0, index_t(computed_.size()), [&](index_t k) { f(computed_[std::size_t(k)]); });
   }
 
   void allocate_sources() {
@@ -736,7 +747,7 @@ class block_solver {
   void save_stage_start() {
     const index_t first = blocks::block_index{n_}(0, 0, 0);
     const index_t count = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1 - first;
-    detail::par_for(threaded_, first_, last_, [&](index_t id) {
+    for_computed([&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       const auto U = detail::conserved_ptrs(std::as_const(b.U));
       const auto U0 = detail::conserved_ptrs(b.U0);
@@ -782,10 +793,10 @@ class block_solver {
       ghosts_and_sweeps(local_ids_);
     }
     if (halo_) timed(times_.exchange, [&] { halo_->exchange_registers(); });
-    timed(times_.fluxes, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { correct_fluxes(id); }); });
+    timed(times_.fluxes, [&] { for_computed([&](index_t id) { correct_fluxes(id); }); });
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
-      timed(times_.sources, [&] { detail::par_for(threaded_, first_, last_, [&](index_t id) { add_sources(id); }); });
+      timed(times_.sources, [&] { for_computed([&](index_t id) { add_sources(id); }); });
   }
 
   /// Primitives and the three flux sweeps of block id (and its viscous pass), keeping its
@@ -854,7 +865,6 @@ class block_solver {
   void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
     constexpr bool one_sided = detail::wants_one_sided<Patcher>() && Recon::second_order;
     const std::span<const patch_face> faces = patcher.patch_faces();
-    require(!halo_, "fluid::block_solver: face patches (the embedded coupling) do not run distributed yet");
     const fluid::view state = view();
     const auto dU = detail::conserved_ptrs(*dU_);
     for (std::size_t pi = 0; pi < faces.size(); ++pi) {
@@ -862,6 +872,9 @@ class block_solver {
       const int d = faces[pi].axis;
       require(d >= 0 && d < 3 && c >= 0 && c < stride_ * block_count(), "fluid::block_solver: bad patched face ", pi,
               " (cell ", c, ", axis ", d, ")");
+      require(computes_[std::size_t(c / stride_)], "fluid::block_solver: patched face ", pi, " (cell ", c,
+              ") lies in a block this process does not compute (a distributed mesh must replicate the blocks the "
+              "coupling touches: mpi::block_halo's replicate_finest)");
       const block& b = blocks_[std::size_t(c / stride_)];
       const auto ijk = b.grid.ijk(c % stride_);
       const index_t m = neighbour(c, d, 0);
@@ -1140,7 +1153,7 @@ class block_solver {
 
   void update(double a, double bcoef, double dt, double t_new, bool last) {
     detail::timed(times_.update, [&] {
-      detail::par_for(threaded_, first_, last_, [&](index_t id) {
+      for_computed([&](index_t id) {
         block& b = blocks_[std::size_t(id)];
         const auto U = detail::conserved_ptrs(b.U);
         const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
@@ -1149,7 +1162,7 @@ class block_solver {
         else detail::update<false>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
       });
       if (last)
-        for (index_t id = first_; id < last_; ++id) {
+        for (index_t id : computed_) {
           const block& b = blocks_[std::size_t(id)];
           detail::check_rows(b.grid, gas_, pose_, detail::conserved_ptrs(std::as_const(b.U)), b.bad_rows.data(), t_new);
         }
@@ -1189,7 +1202,8 @@ class block_solver {
   bool threaded_ = false;
   std::shared_ptr<blocks::halo> halo_;           ///< null: this process computes every block
   bool gathered_ = true;                         ///< every block's state is current on this process (set by gather())
-  index_t first_ = 0, last_ = 0;                 ///< the blocks this process computes
+  std::vector<index_t> computed_;                ///< the blocks this process computes (tree order)
+  std::vector<char> computes_;                   ///< per block: whether this process computes it
   std::vector<index_t> local_ids_, remote_ids_;  ///< owned blocks whose ghosts are all local / read remote cells
 };
 

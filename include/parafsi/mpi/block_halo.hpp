@@ -7,7 +7,10 @@
 ///   solver.set_halo(halo);   // every process: the same mesh and state before, the same calls after
 ///
 /// On `rebuild` (construction, every regrid) each process partitions the leaves' Morton
-/// order by the blocks' costs into one contiguous range per rank (blocks::partition) and,
+/// order by the blocks' costs into one contiguous range per rank (blocks::partition); with
+/// `replicate_finest` the finest level's blocks are left out of the partition and computed
+/// by every process (a coupling's region: the structure is replicated and sees the same air
+/// everywhere, so the loads need no reduction). Then,
 /// from the replicated plans, lists for every other rank the cells it must send there and
 /// receive from there: the interior cells the ghost plans of the receiver's blocks read
 /// (blocks::plan_reads) and the register entries its flux corrections read
@@ -63,26 +66,56 @@ class environment {
   bool owner_ = false;
 };
 
+/// Options of block_halo.
+struct halo_options {
+  /// Every process computes the blocks of the finest level (when the mesh has more than
+  /// one): the region where a coupling reads and writes the air when the structure lives on
+  /// the finest level, as in the drop. The other blocks are partitioned.
+  bool replicate_finest = false;
+};
+
 class block_halo final : public fluid::blocks::halo {
  public:
   using cell_ref = fluid::blocks::cell_ref;
   using lists = std::vector<std::vector<cell_ref>>;  ///< per peer rank, sorted
 
-  explicit block_halo(MPI_Comm comm = MPI_COMM_WORLD) : comm_(comm) {
+  using options = halo_options;
+
+  explicit block_halo(MPI_Comm comm = MPI_COMM_WORLD, halo_options o = halo_options{}) : comm_(comm), opt_(o) {
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
   }
 
-  std::pair<index_t, index_t> rebuild(const fluid::blocks::mesh_view& m) override {
+  std::vector<index_t> rebuild(const fluid::blocks::mesh_view& m) override {
     m_ = m;
     const index_t nb = index_t(m_.plan->size());
     require(m_.leaves && m_.corrections && m_.U && index_t(m_.registers.size()) == nb &&
                 index_t(m_.weight.size()) == nb,
             "mpi::block_halo: incomplete mesh view");
-    starts_ = fluid::blocks::partition(m_.weight, size_);
-    owner_ = fluid::blocks::owners(starts_);
+    // Replicated blocks, then a partition of the others' Morton order by weight.
+    const int finest = m_.leaves->finest_level();
+    everywhere_.assign(std::size_t(nb), 0);
+    if (opt_.replicate_finest && finest > 0)
+      for (index_t b = 0; b < nb; ++b) everywhere_[std::size_t(b)] = m_.leaves->leaf(b).level == finest;
+    std::vector<index_t> spread;
+    std::vector<double> w;
+    for (index_t b = 0; b < nb; ++b)
+      if (!everywhere_[std::size_t(b)]) {
+        spread.push_back(b);
+        w.push_back(m_.weight[std::size_t(b)]);
+      }
+    const auto cut = spread.empty() ? std::vector<index_t>(std::size_t(size_) + 1, 0)
+                                    : fluid::blocks::partition(w, size_);
+    owner_.assign(std::size_t(nb), 0);
+    owned_.assign(std::size_t(size_), {});
+    for (int r = 0; r < size_; ++r)
+      for (index_t k = cut[std::size_t(r)]; k < cut[std::size_t(r) + 1]; ++k) {
+        owner_[std::size_t(spread[std::size_t(k)])] = r;
+        owned_[std::size_t(r)].push_back(spread[std::size_t(k)]);
+      }
     // This process's part of the whole mesh's transfers, already sorted by (peer, block, cell).
-    const auto [state, regs] = fluid::blocks::plan_transfers(*m_.plan, *m_.corrections, m_.n, starts_);
+    const auto [state, regs] = fluid::blocks::plan_transfers(*m_.plan, *m_.corrections, m_.n, owner_, everywhere_,
+                                                             size_);
     auto split = [&](const std::vector<fluid::blocks::transfer>& all, lists& send, lists& recv) {
       send.assign(std::size_t(size_), {});
       recv.assign(std::size_t(size_), {});
@@ -93,12 +126,16 @@ class block_halo final : public fluid::blocks::halo {
     };
     split(state, state_send_, state_recv_);
     split(regs, reg_send_, reg_recv_);
+    std::vector<index_t> computed;
     remote_reader_.assign(std::size_t(nb), 0);
-    for (index_t b = starts_[std::size_t(rank_)]; b < starts_[std::size_t(rank_) + 1]; ++b)
+    for (index_t b = 0; b < nb; ++b) {
+      if (!computes(b)) continue;
+      computed.push_back(b);
       fluid::blocks::plan_reads((*m_.plan)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
-        if (owner_[std::size_t(c.block)] != rank_) remote_reader_[std::size_t(b)] = 1;
+        if (!computes(c.block)) remote_reader_[std::size_t(b)] = 1;
       });
-    return {starts_[std::size_t(rank_)], starts_[std::size_t(rank_) + 1]};
+    }
+    return computed;
   }
 
   void begin_state() override {
@@ -117,26 +154,19 @@ class block_halo final : public fluid::blocks::halo {
   void gather_state() override {
     const index_t n = m_.n;
     const int fields = m_.mu_t.empty() ? 5 : 6;  // the conserved state, and μ_t with a closure
-    const index_t per = fields * n * n * n;
     const fluid::blocks::block_index at{n};
-    const auto [counts, displs] = layout(per);
-    const index_t nb = starts_.back();
-    require(double(per) * double(nb) < 2e9, "mpi::block_halo::gather_state: the mesh is too large for one message");
-    gather_.resize(std::size_t(per * nb));
-    auto each = [&](index_t b, auto&& f) {
-      double* o = gather_.data() + per * b;
+    gather_by_owner(fields * n * n * n, [&](index_t b, double* o, bool pack) {
       for (int q = 0; q < fields; ++q) {
         double* u = q < 5 ? (*m_.U)[std::size_t(b)][q] : m_.mu_t[std::size_t(b)];
         for (index_t k = 0; k < n; ++k)
           for (index_t j = 0; j < n; ++j)
-            for (index_t i = 0; i < n; ++i) f(*o++, u[at(i, j, k)]);
+            for (index_t i = 0; i < n; ++i) {
+              double& v = u[at(i, j, k)];
+              if (pack) *o++ = v;
+              else v = *o++;
+            }
       }
-    };
-    for (index_t b = starts_[std::size_t(rank_)]; b < starts_[std::size_t(rank_) + 1]; ++b)
-      each(b, [](double& buf, double& u) { buf = u; });
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
-    for (index_t b = 0; b < nb; ++b)
-      if (owner_[std::size_t(b)] != rank_) each(b, [](double& buf, double& u) { u = buf; });
+    });
   }
 
   double max(double local) override {
@@ -146,30 +176,56 @@ class block_halo final : public fluid::blocks::halo {
   }
 
   void gather_blocks(std::vector<double>& per_block, int width) override {
-    const auto [counts, displs] = layout(width);
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, per_block.data(), counts.data(), displs.data(), MPI_DOUBLE,
-                   comm_);
+    gather_by_owner(width, [&](index_t b, double* o, bool pack) {
+      for (int k = 0; k < width; ++k) {
+        double& v = per_block[std::size_t(b * width + k)];
+        if (pack) *o++ = v;
+        else v = *o++;
+      }
+    });
   }
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   fluid::blocks::halo_counters counters() const override { return count_; }
-  /// The first block of each rank (and the block count at the end).
-  const std::vector<index_t>& starts() const noexcept { return starts_; }
+  /// The partitioned blocks each rank owns (replicated blocks are in no list).
+  const std::vector<std::vector<index_t>>& owned() const noexcept { return owned_; }
   /// Cells (state) this rank sends per exchange to each rank.
   const lists& state_sends() const noexcept { return state_send_; }
   const lists& register_sends() const noexcept { return reg_send_; }
 
  private:
-  /// Counts and displacements of an MPI_Allgatherv of `per` values per block.
-  std::pair<std::vector<int>, std::vector<int>> layout(index_t per) const {
+  bool computes(index_t b) const noexcept { return everywhere_[std::size_t(b)] || owner_[std::size_t(b)] == rank_; }
+
+  /// MPI_Allgatherv of `per` values per partitioned block, each from its owner:
+  /// io(block, buffer, pack) packs (pack true) or unpacks the block's values.
+  template <class IO>
+  void gather_by_owner(index_t per, IO&& io) {
     std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_));
+    double total = 0;
     for (int r = 0; r < size_; ++r) {
-      counts[std::size_t(r)] = int(per * (starts_[std::size_t(r) + 1] - starts_[std::size_t(r)]));
-      displs[std::size_t(r)] = int(per * starts_[std::size_t(r)]);
+      displs[std::size_t(r)] = int(total);
+      counts[std::size_t(r)] = int(per * index_t(owned_[std::size_t(r)].size()));
+      total += double(counts[std::size_t(r)]);
     }
-    return {counts, displs};
+    require(total < 2e9, "mpi::block_halo: the mesh is too large for one gather message");
+    gather_.resize(std::size_t(total));
+    double* mine = gather_.data() + displs[std::size_t(rank_)];
+    for (index_t b : owned_[std::size_t(rank_)]) {
+      io(b, mine, true);
+      mine += per;
+    }
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
+    for (int r = 0; r < size_; ++r) {
+      if (r == rank_) continue;
+      double* o = gather_.data() + displs[std::size_t(r)];
+      for (index_t b : owned_[std::size_t(r)]) {
+        io(b, o, false);
+        o += per;
+      }
+    }
   }
+
   /// The conserved value f of a cell (the state exchange's storage).
   struct state_at {
     const block_halo* h;
@@ -222,9 +278,11 @@ class block_halo final : public fluid::blocks::halo {
   int rank_ = 0, size_ = 1;
   static constexpr int tag_ = 4242;
   fluid::blocks::mesh_view m_;
-  std::vector<index_t> starts_;
-  std::vector<int> owner_;
-  std::vector<char> remote_reader_;  ///< per block: its ghost plan reads another process's cells
+  options opt_;
+  std::vector<int> owner_;                   ///< per block: its owner (0 for replicated blocks)
+  std::vector<char> everywhere_;             ///< per block: computed by every process
+  std::vector<std::vector<index_t>> owned_;  ///< per rank: its partitioned blocks
+  std::vector<char> remote_reader_;          ///< per block: its ghost plan reads another process's cells
   lists state_send_, state_recv_, reg_send_, reg_recv_;
   std::vector<std::vector<double>> sbuf_, rbuf_;
   std::vector<double> gather_;

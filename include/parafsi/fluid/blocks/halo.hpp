@@ -5,8 +5,10 @@
 /// Every process keeps the whole tree, its exchange plans and flux corrections, and storage
 /// for every block (the mesh's metadata is small; the storage is replicated for now, see
 /// docs/guide_mpi.md), but computes only the blocks it owns: a contiguous range of the
-/// leaves' Morton order, cut by cost (`partition`). A stage of the block solver then reads
-/// three kinds of data another process computed:
+/// leaves' Morton order, cut by cost (`partition`), and the blocks every process computes
+/// (optionally: the region a coupling reads and writes, so that the replicated structure
+/// sees the same air on every process). A stage of the block solver then reads three
+/// kinds of data another process computed:
 ///   - the interior cells that its own blocks' ghost plans read (copies, restrictions and
 ///     the prolongation stencils, blocks/exchange.hpp): `plan_reads` lists them;
 ///   - the face-register entries of finer blocks that its coarse blocks' flux corrections
@@ -14,8 +16,9 @@
 ///   - reductions: the stable step (a maximum, exact) and sums over the mesh, which are
 ///     formed per block and added in block order on every process, so that they do not
 ///     depend on the number of processes.
-/// Each block is computed by exactly one process with the serial kernels, and a value is
-/// moved, never recomputed, so a run gives the same bits on any number of processes.
+/// A block is computed by its owner (or by every process, from the same inputs) with the
+/// serial kernels, and a value is moved, never recomputed differently, so a run gives the
+/// same bits on any number of processes.
 ///
 /// References: Burstedde C., Wilcox L.C., Ghattas O. (2011) SIAM J. Sci. Comput. 33:1103
 ///   (p4est: partition of the Morton order by weight); Stone J.M. et al. (2020) ApJS 249:4
@@ -128,31 +131,43 @@ struct transfer {
 };
 
 /// Every cell (state exchange) or register entry (flux correction) that crosses between
-/// processes in a stage for the partition `starts`, sorted by (from, to, block, cell) and
-/// without repeats: the exchange lists of every process at once (a process sends the
-/// entries with from == its rank, grouped by `to`, and receives those with to == its rank),
-/// and the communication model's counts (bench/halo_model.cpp).
+/// processes in a stage, sorted by (from, to, block, cell) and without repeats: the exchange
+/// lists of every process at once (a process sends the entries with from == its rank,
+/// grouped by `to`, and receives those with to == its rank), and the communication model's
+/// counts (bench/halo_model.cpp). Block b is computed by process owner[b], or by every
+/// process if everywhere[b] (a replicated block: a coupling's region); a process receives
+/// what the blocks it computes read of blocks it does not compute, from their owners.
 inline std::pair<std::vector<transfer>, std::vector<transfer>> plan_transfers(
     const std::vector<block_plan>& plan, const std::vector<std::vector<flux_correction>>& corrections, index_t n,
-    const std::vector<index_t>& starts) {
-  const std::vector<int> own = owners(starts);
+    const std::vector<int>& owner, const std::vector<char>& everywhere, int processes) {
   std::vector<transfer> state, regs;
   for (std::size_t b = 0; b < plan.size(); ++b) {
-    const int to = own[b];
-    auto note = [&](std::vector<transfer>& out) {
-      return [&, to](const cell_ref& c) {
-        const int from = own[std::size_t(c.block)];
-        if (from != to) out.push_back({from, to, c});
+    const int r0 = everywhere[b] ? 0 : owner[b], r1 = everywhere[b] ? processes : owner[b] + 1;
+    for (int to = r0; to < r1; ++to) {
+      auto note = [&](std::vector<transfer>& out) {
+        return [&, to](const cell_ref& c) {
+          const std::size_t src = std::size_t(c.block);
+          if (!everywhere[src] && owner[src] != to) out.push_back({owner[src], to, c});
+        };
       };
-    };
-    plan_reads(plan[b], n, note(state));
-    correction_reads(corrections[b], n, note(regs));
+      plan_reads(plan[b], n, note(state));
+      correction_reads(corrections[b], n, note(regs));
+    }
   }
   for (auto* v : {&state, &regs}) {
     std::sort(v->begin(), v->end());
     v->erase(std::unique(v->begin(), v->end()), v->end());
   }
   return {std::move(state), std::move(regs)};
+}
+
+/// The same for contiguous ranges (blocks [starts[r], starts[r + 1]) on process r) and no
+/// replicated blocks.
+inline std::pair<std::vector<transfer>, std::vector<transfer>> plan_transfers(
+    const std::vector<block_plan>& plan, const std::vector<std::vector<flux_correction>>& corrections, index_t n,
+    const std::vector<index_t>& starts) {
+  return plan_transfers(plan, corrections, n, owners(starts), std::vector<char>(plan.size(), 0),
+                        int(starts.size()) - 1);
 }
 
 /// What a halo reads and writes of a block mesh (block_solver::mesh_view()).
@@ -181,15 +196,15 @@ class halo {
  public:
   virtual ~halo() = default;
   /// The mesh is new (construction, regrid, restart): partition it and plan the messages;
-  /// returns the owned range [first, last) of block ids.
-  virtual std::pair<index_t, index_t> rebuild(const mesh_view& m) = 0;
+  /// returns the blocks this process computes, in tree order.
+  virtual std::vector<index_t> rebuild(const mesh_view& m) = 0;
   /// Bring the cells the owned blocks' ghost plans read from their owners (before a stage),
   /// in two halves: begin_state() starts the messages, end_state() waits for them and
   /// stores the cells; between the two the solver works on the blocks that read no other
   /// process's cells (reads_remote(id) false).
   virtual void begin_state() = 0;
   virtual void end_state() = 0;
-  /// Whether the ghost plan of owned block `id` reads cells of another process.
+  /// Whether the ghost plan of computed block `id` reads cells this process does not compute.
   virtual bool reads_remote(index_t id) const = 0;
   /// Bring the finer blocks' register entries the owned coarse blocks' corrections read.
   virtual void exchange_registers() = 0;
@@ -198,8 +213,8 @@ class halo {
   virtual void gather_state() = 0;
   /// The maximum of a value over the processes.
   virtual double max(double local) = 0;
-  /// per_block holds `width` values per block, filled for the owned blocks: fill the rest
-  /// from their owners.
+  /// per_block holds `width` values per block, filled for the blocks this process computes:
+  /// fill the rest from their owners.
   virtual void gather_blocks(std::vector<double>& per_block, int width) = 0;
   /// This process's rank and the number of processes.
   virtual int rank() const = 0;

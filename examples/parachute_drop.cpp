@@ -29,6 +29,11 @@
 // include/parafsi/io/drop_summary.hpp and docs/validation.md. Progress on stderr; the
 // summary row on stdout at the end.
 //
+// Under MPI (built with parafsi::mpi when MPI is found): `mpirun -np N parachute_drop
+// --mesh blocks ...` with the same flags splits the block mesh over the N processes (the
+// canopy's finest level computed by every process, the rest partitioned; docs/guide_mpi.md);
+// process 0 prints and writes the files, which are those of one process bit for bit.
+//
 // The run is scene::run_drop (include/parafsi/scene/drop.hpp); the flags bind directly to
 // the fields of scene::drop_config, whose defaults are the program's. Every floating
 // flag refuses NaN and ±inf (examples::finite); a write that fails (a full disk, a
@@ -77,7 +82,21 @@ std::string join_list(const std::vector<double>& v) {
 
 }  // namespace
 
+#ifdef PARAFSI_WITH_MPI
+#include <parafsi/mpi/block_halo.hpp>
+#endif
+
 int main(int argc, char** argv) {
+#ifdef PARAFSI_WITH_MPI
+  parafsi::mpi::environment mpi_env(argc, argv, /*only_if_launched=*/true);  // run alone: no MPI start-up
+  int ranks = 1, rank = 0;
+  if (mpi_env.active()) {
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  }
+#else
+  const int ranks = 1, rank = 0;
+#endif
   CLI::App app{"Parachute-payload drop (the paper's section 4 scene): coupled fluid, canopy, lines and payload"};
   parafsi::scene::drop_config c;  // the defaults
   int threads = 0;
@@ -257,6 +276,19 @@ int main(int argc, char** argv) {
   int rc = 0;
   if (!examples::parse(app, argc, argv, rc)) return rc;
   if (threads > 0) parafsi::parallel::set_threads(threads);
+  if (ranks > 1) {
+    if (c.mesh != "blocks") {
+      if (rank == 0)
+        std::fprintf(stderr, "parachute_drop: %d processes need --mesh blocks (the tensor box runs on one)\n", ranks);
+      return 2;
+    }
+#ifdef PARAFSI_WITH_MPI
+    parafsi::mpi::halo_options ho;
+    ho.replicate_finest = true;  // the canopy's level: the coupling reads and writes it on every process
+    c.halo = std::make_shared<parafsi::mpi::block_halo>(MPI_COMM_WORLD, ho);
+#endif
+    if (rank != 0) c.quiet = true;
+  }
 
   return examples::guarded("parachute_drop", [&]() -> int {
     examples::progress prog("parachute_drop", c.t_end, c.quiet);
@@ -264,7 +296,7 @@ int main(int argc, char** argv) {
       if (done) prog.finish(t, steps);
       else prog(t, steps);
     });
-    std::printf("%s\n%s\n", parafsi::io::drop_summary_header, r.summary.csv_row().c_str());
+    if (rank == 0) std::printf("%s\n%s\n", parafsi::io::drop_summary_header, r.summary.csv_row().c_str());
     return 0;
   });
 }

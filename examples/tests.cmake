@@ -364,3 +364,58 @@ if(Python3_Interpreter_FOUND)
             --bin $<TARGET_FILE_DIR:parachute_drop> --timeout 20 --jobs 2)
   set_tests_properties(example_cli_robustness PROPERTIES TIMEOUT 900 LABELS examples)
 endif()
+
+# ---- The drop over MPI processes (docs/guide_mpi.md): the tiny block-mesh drop for 0.05 s
+#      on one process without mpirun, then under mpiexec on N processes: history.csv,
+#      summary.csv and mesh.csv must be the same bytes. With N = 2 also a checkpoint
+#      written at 0.03 s by 2 processes, restarted on 4 and on 1 (no mpirun): the same
+#      history.csv again.
+if(TARGET parafsi::mpi)
+  set(_ex_mpi_drop ${CMAKE_CURRENT_BINARY_DIR}/run_mpi_drop.cmake)
+  file(WRITE ${_ex_mpi_drop} [=[
+file(REMOVE_RECURSE ${OUT})
+file(MAKE_DIRECTORY ${OUT})
+set(ARGS --resolution tiny --mesh blocks --block-size 4 --quiet)
+set(MPI ${MPIEXEC} ${NPFLAG})
+function(run label)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${label} exited with ${rc}:\n${out}\n${err}")
+  endif()
+endfunction()
+function(same a b)
+  foreach(f IN LISTS ARGN)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${a}/${f} ${b}/${f} RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "${b}/${f} differs from ${a}/${f}")
+    endif()
+  endforeach()
+  message("${b}: ${ARGN} identical to ${a}")
+endfunction()
+run("one process" ${PROGRAM} ${ARGS} --t-end 0.05 --out ${OUT}/one)
+run("${NP} processes" ${MPI} ${NP} ${FLAGS} ${PROGRAM} ${ARGS} --t-end 0.05 --out ${OUT}/np${NP})
+same(${OUT}/one ${OUT}/np${NP} history.csv summary.csv mesh.csv)
+if(NP EQUAL 2)
+  run("checkpoint on 2" ${MPI} 2 ${FLAGS} ${PROGRAM} ${ARGS} --t-end 0.03 --checkpoint-every 0.03 --out ${OUT}/ck2)
+  run("restart on 4" ${MPI} 4 ${FLAGS} ${PROGRAM} ${ARGS} --t-end 0.05 --restart ${OUT}/ck2/checkpoint.ckpt
+      --out ${OUT}/rs4)
+  run("restart on 1" ${PROGRAM} ${ARGS} --t-end 0.05 --restart ${OUT}/ck2/checkpoint.ckpt --out ${OUT}/rs1)
+  same(${OUT}/one ${OUT}/rs4 history.csv summary.csv)
+  same(${OUT}/one ${OUT}/rs1 history.csv summary.csv)
+endif()
+]=])
+  set(_mpi_flags ${MPIEXEC_PREFLAGS})
+  if(MPI_CXX_LIBRARY_VERSION_STRING MATCHES "Open MPI" OR MPIEXEC_EXECUTABLE MATCHES "openmpi|orterun")
+    list(APPEND _mpi_flags --oversubscribe)
+  endif()
+  string(REPLACE ";" " " _mpi_flags_str "${_mpi_flags}")
+  foreach(np 1 2 4)
+    add_test(NAME example_parachute_drop_mpi_np${np}
+      COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:parachute_drop> -DMPIEXEC=${MPIEXEC_EXECUTABLE}
+              -DNPFLAG=${MPIEXEC_NUMPROC_FLAG} -DNP=${np} "-DFLAGS=${_mpi_flags}"
+              -DOUT=${_ex_out}/mpi_drop_np${np} -P ${_ex_mpi_drop})
+    set_tests_properties(example_parachute_drop_mpi_np${np} PROPERTIES TIMEOUT 600 LABELS "examples;mpi"
+      PROCESSORS ${np}
+      ENVIRONMENT "OMP_NUM_THREADS=1;OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
+  endforeach()
+endif()

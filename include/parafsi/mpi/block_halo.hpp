@@ -33,6 +33,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -43,17 +44,30 @@
 
 namespace parafsi::mpi {
 
+/// Whether this process was started by an MPI launcher (mpirun/mpiexec of Open MPI or
+/// MPICH, Slurm's srun with PMI or PMIx): the environment variables they set.
+inline bool launched() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
 /// MPI_Init / MPI_Finalize for a program's lifetime (a no-op if MPI is already initialised).
+/// With `only_if_launched`, MPI is started only under a launcher (launched()), so a program
+/// run on its own does not pay MPI's start-up; active() says whether it was.
 class environment {
  public:
-  environment(int& argc, char**& argv) {
+  environment(int& argc, char**& argv, bool only_if_launched = false) {
     int done = 0;
     MPI_Initialized(&done);
-    if (!done) {
+    if (!done && (!only_if_launched || launched())) {
       MPI_Init(&argc, &argv);
       owner_ = true;
+      done = 1;
     }
+    active_ = done != 0;
   }
+  bool active() const noexcept { return active_; }
   ~environment() {
     int fin = 0;
     MPI_Finalized(&fin);
@@ -63,7 +77,7 @@ class environment {
   environment& operator=(const environment&) = delete;
 
  private:
-  bool owner_ = false;
+  bool owner_ = false, active_ = false;
 };
 
 /// Options of block_halo.

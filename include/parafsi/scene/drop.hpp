@@ -61,6 +61,7 @@
 #include <functional>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -75,6 +76,7 @@
 #include "../core/parallel.hpp"
 #include "../coupling/coupling.hpp"
 #include "../explicit_stepper.hpp"
+#include "../fluid/blocks/halo.hpp"
 #include "../fluid/fluid.hpp"
 #include "../io/block_vtk.hpp"
 #include "../io/checkpoint.hpp"
@@ -150,6 +152,10 @@ struct drop_config {
   double checkpoint_every = 0;  ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
   std::string restart;          ///< checkpoint to continue from (same scene and flags)
   bool quiet = false;           ///< no messages on stderr
+  /// Block mesh over several processes (set by a distributed program, e.g. with
+  /// mpi::block_halo and replicate_finest: the canopy's level is computed by every process,
+  /// the rest partitioned); every process runs the same drop, process 0 writes the files.
+  std::shared_ptr<fluid::blocks::halo> halo;
 
   /// Throws invalid_input naming a bad field (non-finite numbers included).
   void validate() const {
@@ -398,9 +404,15 @@ class drop_run {
         pgs_{su.alpha},
         p_offset_(pgs_.pressure_offset(su.params.air_pressure)),
         c_air_(gas::ideal{}.sound_speed(su.params.air_density, su.params.air_pressure)),
-        files_(!c.out.empty()),
+        files_(!c.out.empty() && (!c.halo || c.halo->rank() == 0)),
         filter_(io::gaussian_lowpass(c.force_cutoff, c.history_every)),
-        signature_(drop_signature(c, su)) {}
+        signature_(drop_signature(c, su)) {
+    if constexpr (block_mesh) {
+      if (c.halo) s_.fluid().set_halo(c.halo);
+    } else {
+      require(!c.halo, "parachute_drop: only the block mesh (--mesh blocks) runs over several processes");
+    }
+  }
   drop_run(const drop_run&) = delete;
   drop_run& operator=(const drop_run&) = delete;
 
@@ -498,7 +510,7 @@ class drop_run {
     const std::vector<double>& slices = c_.slice_times;
     std::size_t next_slice = 0;
     while (next_slice < slices.size() && slices[next_slice] <= s_.time() + 1e-9 && !c_.restart.empty()) ++next_slice;
-    while (files_ && next_slice < slices.size() && slices[next_slice] <= 0) {
+    while (!c_.out.empty() && next_slice < slices.size() && slices[next_slice] <= 0) {
       write_slice(0.0);
       ++next_slice;
     }
@@ -519,7 +531,7 @@ class drop_run {
         record(history);
         write_outputs();
         next_out = c_.history_every * double(++n_out);
-        while (files_ && next_slice < slices.size() && s_.time() >= slices[next_slice] - 1e-9)
+        while (!c_.out.empty() && next_slice < slices.size() && s_.time() >= slices[next_slice] - 1e-9)
           write_slice(slices[next_slice++]);
       }
       if (progress) progress(s_.time(), s_.steps(), false);
@@ -554,6 +566,8 @@ class drop_run {
 
   /// history.csv (its header; the rows follow through `emit`); the VTK series.
   void open_outputs() {
+    next_vtk_ = s_.time();
+    next_ckpt_ = s_.time() + c_.checkpoint_every;
     if (!files_) return;
     hist_.emplace(out() / "history.csv");
     if constexpr (block_mesh) {
@@ -568,8 +582,6 @@ class drop_run {
       std::filesystem::create_directories(out() / "vtk");
       pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
     }
-    next_vtk_ = s_.time();
-    next_ckpt_ = s_.time() + c_.checkpoint_every;
   }
 
   /// The history row of now, the αM guard, the row to history.csv.
@@ -596,31 +608,44 @@ class drop_run {
     hist_->flush();
   }
 
-  /// VTK files and the checkpoint when their instants are reached.
+  /// VTK files and the checkpoint when their instants are reached (on every process: a
+  /// distributed mesh is gathered first, and process 0 writes).
   void write_outputs() {
-    if (pvd_ && s_.time() >= next_vtk_ - 1e-9 * c_.history_every) {
-      char nm[64];
-      std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
-      const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu",
-                        ff = c_.out + "/vtk/fluid_" + nm + (block_mesh ? ".vtu" : ".vts");
-      io::write_vtu(fs, s_.structure());
-      io::vtk_options vo;
-      vo.pressure_offset = p_offset_;
-      if constexpr (block_mesh) io::write_vtu(ff, s_.fluid(), vo);  // leaf cells as hexahedra
-      else io::write_vts(ff, s_.fluid(), vo);
-      pvd_->add(s_.time(), ff, 0);
-      pvd_->add(s_.time(), fs, 1);
+    const bool vtk = !c_.out.empty() && c_.vtk_every > 0 && s_.time() >= next_vtk_ - 1e-9 * c_.history_every;
+    const bool ckpt = !c_.out.empty() && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every;
+    if (vtk || ckpt) gather_fluid();
+    if (vtk) {
+      if (pvd_) {
+        char nm[64];
+        std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
+        const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu",
+                          ff = c_.out + "/vtk/fluid_" + nm + (block_mesh ? ".vtu" : ".vts");
+        io::write_vtu(fs, s_.structure());
+        io::vtk_options vo;
+        vo.pressure_offset = p_offset_;
+        if constexpr (block_mesh) io::write_vtu(ff, s_.fluid(), vo);  // leaf cells as hexahedra
+        else io::write_vts(ff, s_.fluid(), vo);
+        pvd_->add(s_.time(), ff, 0);
+        pvd_->add(s_.time(), fs, 1);
+      }
       next_vtk_ += c_.vtk_every;
     }
-    if (files_ && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every) {
-      io::save_checkpoint(c_.out + "/checkpoint.ckpt", signature_, s_, io::drop_history_record{*history_});
+    if (ckpt) {
+      if (files_) io::save_checkpoint(c_.out + "/checkpoint.ckpt", signature_, s_, io::drop_history_record{*history_});
       next_ckpt_ += c_.checkpoint_every;
     }
   }
 
   void write_slice(double t_label) {
+    gather_fluid();
+    if (!files_) return;
     io::write_drop_slice(out(), t_label, s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
                          structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
+  }
+
+  /// A distributed block mesh's cells to every process (collective; nothing otherwise).
+  void gather_fluid() {
+    if constexpr (block_mesh) s_.fluid().gather();
   }
 
   /// Block mesh: refine to the canopy's current place (drop_block_target) and, with

@@ -290,7 +290,7 @@ int main(int argc, char** argv) {
     if (rank != 0) c.quiet = true;
   }
 
-  return examples::guarded("parachute_drop", [&]() -> int {
+  const int status = examples::guarded("parachute_drop", [&]() -> int {
     examples::progress prog("parachute_drop", c.t_end, c.quiet);
     const auto r = parafsi::scene::run_drop(c, [&](double t, long steps, bool done) {
       if (done) prog.finish(t, steps);
@@ -299,4 +299,10 @@ int main(int argc, char** argv) {
     if (rank == 0) std::printf("%s\n%s\n", parafsi::io::drop_summary_header, r.summary.csv_row().c_str());
     return 0;
   });
+#ifdef PARAFSI_WITH_MPI
+  // An error on one process (its message printed above) stops them all: the others may
+  // wait in a collective call that this one will never make.
+  if (status != 0 && ranks > 1) MPI_Abort(MPI_COMM_WORLD, status);
+#endif
+  return status;
 }

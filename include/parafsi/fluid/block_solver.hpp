@@ -377,6 +377,7 @@ class block_solver {
   /// Every block's interior cells from its owner to every process (collective; a no-op
   /// when not distributed).
   void gather() {
+    reattach_if_moved();
     if (halo_) halo_->gather_state();
     gathered_ = true;
   }
@@ -430,6 +431,7 @@ class block_solver {
   void step(double dt, const frame::motion& m, Patcher& patcher) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step: dt must be positive and finite, got ", dt);
     gathered_ = !halo_;
+    reattach_if_moved();
     pose_.set_motion(m);
     save_stage_start();
     double pose_time = 0.0;
@@ -710,6 +712,7 @@ class block_solver {
   /// whose ghosts are all local and those that read another process's cells.
   void attach_halo() {
     computed_.clear();
+    attached_to_ = this;
     if (halo_) computed_ = halo_->rebuild(mesh_view());
     else
       for (index_t id = 0; id < block_count(); ++id) computed_.push_back(id);
@@ -718,6 +721,12 @@ class block_solver {
     local_ids_.clear();
     remote_ids_.clear();
     for (index_t id : computed_) (halo_ && halo_->reads_remote(id) ? remote_ids_ : local_ids_).push_back(id);
+  }
+
+  /// The halo holds pointers into this object (its tree, plans and storage table): after a
+  /// move, attach again (collective: every process moves its solver alike).
+  void reattach_if_moved() {
+    if (halo_ && attached_to_ != this) attach_halo();
   }
 
   /// f(id) for every block this process computes, in parallel over blocks.
@@ -1201,6 +1210,7 @@ class block_solver {
   phase_times times_{};
   bool threaded_ = false;
   std::shared_ptr<blocks::halo> halo_;           ///< null: this process computes every block
+  const block_solver* attached_to_ = nullptr;    ///< the object the halo's pointers point into
   bool gathered_ = true;                         ///< every block's state is current on this process (set by gather())
   std::vector<index_t> computed_;                ///< the blocks this process computes (tree order)
   std::vector<char> computes_;                   ///< per block: whether this process computes it

@@ -8,19 +8,16 @@
 ///
 /// On `rebuild` (construction, every regrid) each process partitions the leaves' Morton
 /// order by the blocks' costs into one contiguous range per rank (blocks::partition); with
-/// `replicate_finest` the finest level's blocks are left out of the partition and computed
-/// by every process (a coupling's region: the structure is replicated and sees the same air
-/// everywhere, so the loads need no reduction). Then,
-/// from the replicated plans, lists for every other rank the cells it must send there and
-/// receive from there: the interior cells the ghost plans of the receiver's blocks read
-/// (blocks::plan_reads) and the register entries its flux corrections read
-/// (blocks::correction_reads), sorted by (block, cell), so sender and receiver agree on the
-/// order without sending it. A state exchange is then one message per neighbouring rank
-/// each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps
-/// the owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state)
-/// and the blocks that read remote cells, so the messages overlap that work. The register
-/// exchange is the same without overlap. The reductions are MPI_Allreduce (max, exact) and
-/// MPI_Allgatherv of per-block values, added in block order by the caller. Results are
+/// `replicate_finest` the finest level's blocks (every block of a one-level mesh) are left
+/// out of the partition and computed by every process (a coupling's region: the structure is replicated and sees the
+/// same air everywhere, so the loads need no reduction). Then, from the replicated plans, lists for every other rank
+/// the cells it must send there and receive from there: the interior cells the ghost plans of the receiver's blocks
+/// read (blocks::plan_reads) and the register entries its flux corrections read (blocks::correction_reads), sorted by
+/// (block, cell), so sender and receiver agree on the order without sending it. A state exchange is then one message
+/// per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps the
+/// owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read remote
+/// cells, so the messages overlap that work. The register exchange is the same without overlap. The reductions are
+/// MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. Results are
 /// therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
@@ -52,7 +49,7 @@ inline bool launched() {
   return false;
 }
 
-/// MPI_Init / MPI_Finalize for a program's lifetime (a no-op if MPI is already initialised).
+/// MPI_Init_thread (funneled) / MPI_Finalize for a program's lifetime (a no-op if MPI is already initialised).
 /// With `only_if_launched`, MPI is started only under a launcher (launched()), so a program
 /// run on its own does not pay MPI's start-up; active() says whether it was.
 class environment {
@@ -61,7 +58,9 @@ class environment {
     int done = 0;
     MPI_Initialized(&done);
     if (!done && (!only_if_launched || launched())) {
-      MPI_Init(&argc, &argv);
+      // OpenMP threads may run inside a process; only its main thread calls MPI.
+      int provided = 0;
+      MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
       owner_ = true;
       done = 1;
     }
@@ -107,9 +106,11 @@ class block_halo final : public fluid::blocks::halo {
                 index_t(m_.weight.size()) == nb,
             "mpi::block_halo: incomplete mesh view");
     // Replicated blocks, then a partition of the others' Morton order by weight.
+    // (On a one-level mesh the finest level is every block: all are replicated, which is
+    // correct for a coupling and divides nothing.)
     const int finest = m_.leaves->finest_level();
     everywhere_.assign(std::size_t(nb), 0);
-    if (opt_.replicate_finest && finest > 0)
+    if (opt_.replicate_finest)
       for (index_t b = 0; b < nb; ++b) everywhere_[std::size_t(b)] = m_.leaves->leaf(b).level == finest;
     std::vector<index_t> spread;
     std::vector<double> w;
@@ -216,13 +217,15 @@ class block_halo final : public fluid::blocks::halo {
   template <class IO>
   void gather_by_owner(index_t per, IO&& io) {
     std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_));
-    double total = 0;
+    index_t total = 0;
     for (int r = 0; r < size_; ++r) {
+      const index_t count = per * index_t(owned_[std::size_t(r)].size());
+      require(total + count < index_t(2000000000), "mpi::block_halo: the mesh is too large for one gather message (",
+              total + count, " values)");
       displs[std::size_t(r)] = int(total);
-      counts[std::size_t(r)] = int(per * index_t(owned_[std::size_t(r)].size()));
-      total += double(counts[std::size_t(r)]);
+      counts[std::size_t(r)] = int(count);
+      total += count;
     }
-    require(total < 2e9, "mpi::block_halo: the mesh is too large for one gather message");
     gather_.resize(std::size_t(total));
     double* mine = gather_.data() + displs[std::size_t(rank_)];
     for (index_t b : owned_[std::size_t(rank_)]) {

@@ -6,6 +6,7 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
+#include <parafsi/fluid/block_solver.hpp>
 #include <parafsi/fluid/fluid.hpp>
 #include <parafsi/model/duct_screen.hpp>
 #include <parafsi/model/rect_mesh.hpp>
@@ -109,6 +110,27 @@ void window_means(const S& s, double a, double b, double& p, double& u, double& 
       }
   p /= n;
   u /= n;
+}
+
+/// The tilted patch of ctu::tilted_patch on a block mesh of the same periodic 0.4 m box
+/// (2 x 2 x 2 root blocks of 4^3 cells), refined to `levels` within 4 cm of the patch.
+template <class Coupling = pf::coupling::penalty<pf::porosity::impermeable>>
+auto blocks_patch(int levels, Coupling cpl = Coupling{pf::porosity::impermeable{}}, double E = 1e5) {
+  pf::fluid::block_layout lay{{0, 0, 0}, {0.4, 0.4, 0.4}, {2, 2, 2}, 4};
+  const auto m = pf::model::rect_mesh({0.12, 0.1, 0.11}, {0.02, 0.18, 0.0}, {0.0, 0.03, 0.17}, 3, 3);
+  pf::fluid::blocks::tree t({2, 2, 2}, {true, true, true});
+  if (levels > 0) t.refine_where(levels, pf::fluid::blocks::near_points(lay, m.positions, 0.04, levels));
+  pf::fluid::block_solver fl{t, lay, pf::boundary::set::all(pf::boundary::periodic{})};
+  fl.fill_uniform({1.18, {0, 0, 0}, 101325.0});
+  const Eigen::Vector3d v0{4.0, 1.0, -0.5};
+  st::nodes nd;
+  for (const auto& x : m.positions) nd.add(x, v0);
+  st::triangle_mesh tm;
+  tm.triangles = m.triangles;
+  st::membrane_tri mem{tm, st::material::fabric<>::isotropic(E, 0.3, 0.5, 1e-4)};
+  st::assembly as{std::move(nd), std::move(mem)};
+  as.integrator().gravity = {0, 0, 0};
+  return pf::explicit_stepper{std::move(fl), std::move(as), std::move(cpl)};
 }
 
 }  // namespace ctu

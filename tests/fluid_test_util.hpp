@@ -50,4 +50,24 @@ double max_block_box_difference(const B& blk, const S& box) {
   return e;
 }
 
+/// A block tree of root grid nb whose blocks overlapping the sphere (centre, radius) are
+/// refined up to max_level (2:1 balanced).
+inline parafsi::fluid::blocks::tree refined_tree(std::array<pf::index_t, 3> nb, std::array<bool, 3> periodic,
+                                                 const pf::fluid::block_layout& lay, const Eigen::Vector3d& centre,
+                                                 double radius, int max_level) {
+  namespace fb = pf::fluid::blocks;
+  fb::tree t(nb, periodic);
+  t.refine_where(max_level, [&](const fb::location& q) {
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double w = lay.block_width(d, q.level);
+      const double a = lay.lo[std::size_t(d)] + w * double(q.l[std::size_t(d)]), b = a + w;
+      const double c = std::clamp(centre[d], a, b) - centre[d];
+      d2 += c * c;
+    }
+    return d2 < radius * radius;
+  });
+  return t;
+}
+
 }  // namespace pft

@@ -171,24 +171,7 @@ TEST_CASE("one level of blocks reproduces the box solver to round-off (Sod along
   }
 }
 
-namespace {
-/// Refine the blocks whose box overlaps the sphere (centre, radius) up to max_level.
-fb::tree refined_tree(std::array<index_t, 3> nb, std::array<bool, 3> periodic, const fluid::block_layout& lay,
-                      const Eigen::Vector3d& centre, double radius, int max_level) {
-  fb::tree t(nb, periodic);
-  t.refine_where(max_level, [&](const fb::location& q) {
-    double d2 = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double w = lay.block_width(d, q.level);
-      const double a = lay.lo[std::size_t(d)] + w * double(q.l[std::size_t(d)]), b = a + w;
-      const double c = std::clamp(centre[d], a, b) - centre[d];
-      d2 += c * c;
-    }
-    return d2 < radius * radius;
-  });
-  return t;
-}
-}  // namespace
+using pft::refined_tree;
 
 TEST_CASE("two and three levels: conservation to round-off and a uniform stream on a moving box stays uniform") {
   fluid::block_layout lay{{0, 0, 0}, {10, 10, 2.5}, {4, 4, 1}, 8};

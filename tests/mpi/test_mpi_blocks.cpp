@@ -17,42 +17,22 @@
 #include <parafsi/fluid/reference/vortices.hpp>
 #include <parafsi/io/checkpoint.hpp>
 #include <parafsi/mpi/block_halo.hpp>
+
 #include <parafsi/parafsi.hpp>
+#include "../fluid_test_util.hpp"
+#include "mpi_test_util.hpp"
 
 namespace pf = parafsi;
 namespace fluid = pf::fluid;
 namespace fb = pf::fluid::blocks;
 using pf::index_t;
 
+using mpt::sum_over_processes;
+using mpt::world_rank;
+using mpt::world_size;
+using pft::refined_tree;
+
 namespace {
-
-int world_rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-int world_size() {
-  int n = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
-
-/// Refine the blocks whose box overlaps the sphere (centre, radius) up to max_level.
-fb::tree refined_tree(std::array<index_t, 3> nb, std::array<bool, 3> periodic, const fluid::block_layout& lay,
-                      const Eigen::Vector3d& centre, double radius, int max_level) {
-  fb::tree t(nb, periodic);
-  t.refine_where(max_level, [&](const fb::location& q) {
-    double d2 = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double w = lay.block_width(d, q.level);
-      const double a = lay.lo[std::size_t(d)] + w * double(q.l[std::size_t(d)]), b = a + w;
-      const double c = std::clamp(centre[d], a, b) - centre[d];
-      d2 += c * c;
-    }
-    return d2 < radius * radius;
-  });
-  return t;
-}
 
 /// Every leaf cell's 5 conserved values, blocks in tree order.
 template <class S>
@@ -348,12 +328,4 @@ TEST_CASE("distributed block mesh: a solver moved after set_halo attaches again 
   CHECK(mismatches(state_of(*serial), state_of(moved)) == 0);
 }
 
-int main(int argc, char** argv) {
-  pf::mpi::environment env(argc, argv);
-  doctest::Context ctx(argc, argv);
-  if (world_rank() != 0) ctx.setOption("minimal", true);
-  int res = ctx.run();
-  int worst = 0;
-  MPI_Allreduce(&res, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return worst;
-}
+int main(int argc, char** argv) { return mpt::run_tests(argc, argv); }

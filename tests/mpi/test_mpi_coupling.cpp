@@ -14,6 +14,8 @@
 
 #include <parafsi/mpi/block_halo.hpp>
 
+#include "mpi_test_util.hpp"
+
 #include "../coupling_test_util.hpp"
 
 namespace pf = parafsi;
@@ -21,44 +23,11 @@ namespace st = pf::structure;
 namespace fb = pf::fluid::blocks;
 using pf::index_t;
 
+using mpt::sum_over_processes;
+using mpt::world_rank;
+using mpt::world_size;
+
 namespace {
-
-int world_rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-int world_size() {
-  int n = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
-long sum_over_processes(long v) {
-  long all = 0;
-  MPI_Allreduce(&v, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
-  return all;
-}
-
-/// The tilted patch on a periodic 0.4 m box of 2 x 2 x 2 root blocks of 4³ cells, refined
-/// to level 2 within 4 cm of the patch (as tests/test_coupling_blocks.cpp).
-template <class Coupling>
-auto blocks_patch(Coupling cpl) {
-  pf::fluid::block_layout lay{{0, 0, 0}, {0.4, 0.4, 0.4}, {2, 2, 2}, 4};
-  const auto m = pf::model::rect_mesh({0.12, 0.1, 0.11}, {0.02, 0.18, 0.0}, {0.0, 0.03, 0.17}, 3, 3);
-  fb::tree t({2, 2, 2}, {true, true, true});
-  t.refine_where(2, fb::near_points(lay, m.positions, 0.04, 2));
-  pf::fluid::block_solver fl{t, lay, pf::boundary::set::all(pf::boundary::periodic{})};
-  fl.fill_uniform({1.18, {0, 0, 0}, 101325.0});
-  const Eigen::Vector3d v0{4.0, 1.0, -0.5};
-  st::nodes nd;
-  for (const auto& x : m.positions) nd.add(x, v0);
-  st::triangle_mesh tm;
-  tm.triangles = m.triangles;
-  st::membrane_tri mem{tm, st::material::fabric<>::isotropic(1e5, 0.3, 0.5, 1e-4)};
-  st::assembly as{std::move(nd), std::move(mem)};
-  as.integrator().gravity = {0, 0, 0};
-  return pf::explicit_stepper{std::move(fl), std::move(as), std::move(cpl)};
-}
 
 template <class S>
 std::vector<double> fluid_state(S& s) {
@@ -71,8 +40,8 @@ std::vector<double> fluid_state(S& s) {
 
 template <class Make>
 void compare_coupled(const std::string& name, Make make) {
-  auto serial = blocks_patch(make());
-  auto dist = blocks_patch(make());
+  auto serial = ctu::blocks_patch(2, make());
+  auto dist = ctu::blocks_patch(2, make());
   pf::mpi::halo_options o;
   o.replicate_finest = true;
   dist.fluid().set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD, o));
@@ -117,12 +86,4 @@ TEST_CASE("distributed block mesh with the embedded coupling (one-sided faces): 
   compare_coupled("embedded, one-sided", [] { return ctu::embedded_one_sided::make(pf::porosity::impermeable{}, 0); });
 }
 
-int main(int argc, char** argv) {
-  pf::mpi::environment env(argc, argv);
-  doctest::Context ctx(argc, argv);
-  if (world_rank() != 0) ctx.setOption("minimal", true);
-  int res = ctx.run();
-  int worst = 0;
-  MPI_Allreduce(&res, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return worst;
-}
+int main(int argc, char** argv) { return mpt::run_tests(argc, argv); }

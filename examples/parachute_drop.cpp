@@ -284,7 +284,11 @@ int main(int argc, char** argv) {
     }
 #ifdef PARAFSI_WITH_MPI
     parafsi::mpi::halo_options ho;
-    ho.replicate_finest = true;  // the canopy's level: the coupling reads and writes it on every process
+    // Every level is split over the processes; the embedded coupling brings the cells its
+    // faces read to every process each stage. The penalty coupling's points read the air
+    // anywhere in their cells' stencils during the structure's substeps: the canopy's level
+    // is then computed by every process.
+    ho.replicate_finest = c.coupling == "penalty";
     c.halo = std::make_shared<parafsi::mpi::block_halo>(MPI_COMM_WORLD, ho);
 #endif
     if (rank != 0) c.quiet = true;

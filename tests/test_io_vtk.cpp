@@ -478,6 +478,74 @@ TEST_CASE(
   }
 }
 
+TEST_CASE(
+    "block vtu pieces: the .pvtu index names every piece and array; the pieces' cells, in piece order, are the whole "
+    "file's cells value for value") {
+  two_level_mesh m;
+  const auto& s = m.s;
+  const io::vtk_options opt{io::vtk_encoding::ascii, 250.0};
+  const fs::path whole = scratch("pieces_whole.vtu");
+  io::write_vtu(whole, s, opt);
+  const auto wdoc = parse_xml(slurp(whole));
+  const node* wp = wdoc->kids[0]->child("UnstructuredGrid")->child("Piece");
+  const auto wpts = values(wp->child("Points")->child("DataArray")), wconn = values(wp->array("connectivity"));
+  const std::vector<std::string> names{"density", "velocity", "pressure", "vorticity", "level", "block"};
+  // The 8 corner coordinates of every cell, in cell order (points are renumbered per piece).
+  auto corners = [](const std::vector<double>& pts, const std::vector<double>& conn) {
+    std::vector<double> c;
+    for (double q : conn)
+      for (int d = 0; d < 3; ++d) c.push_back(pts[3 * std::size_t(q) + std::size_t(d)]);
+    return c;
+  };
+  const std::vector<double> wcorners = corners(wpts, wconn);
+  for (int pieces : {1, 2, 4, 7, 15}) {
+    const fs::path index = scratch("pieces_" + std::to_string(pieces) + ".pvtu");
+    for (int q = pieces - 1; q >= 0; --q) io::write_pvtu_piece(index, s, opt, q, pieces);
+    const auto doc = parse_xml(slurp(index));
+    const node* pu = doc->kids[0]->child("PUnstructuredGrid");
+    REQUIRE(pu);
+    CHECK(doc->kids[0]->attr.at("type") == "PUnstructuredGrid");
+    std::vector<const node*> listed, arrays;
+    pu->find_all("Piece", listed);
+    pu->child("PCellData")->find_all("PDataArray", arrays);
+    REQUIRE(listed.size() == std::size_t(pieces));
+    REQUIRE(arrays.size() == names.size());
+    std::map<std::string, std::vector<double>> joined;
+    std::vector<double> jcorners;
+    std::size_t cells = 0;
+    for (int q = 0; q < pieces; ++q) {
+      const std::string src = listed[std::size_t(q)]->attr.at("Source");
+      CHECK(src == "pieces_" + std::to_string(pieces) + "_" + std::to_string(q) + ".vtu");
+      const auto pdoc = parse_xml(slurp(index.parent_path() / src));
+      const node* piece = pdoc->kids[0]->child("UnstructuredGrid")->child("Piece");
+      const io::block_range r = io::piece_blocks(s.block_count(), q, pieces);
+      const std::size_t pc = std::stoul(piece->attr.at("NumberOfCells"));
+      CHECK(pc == std::size_t((r.last - r.first) * m.n * m.n * m.n));
+      cells += pc;
+      for (std::size_t a = 0; a < names.size(); ++a) {
+        const node* arr = piece->array(names[a]);
+        REQUIRE(arr);
+        CHECK(arr->attr.at("type") == arrays[a]->attr.at("type"));
+        CHECK(arrays[a]->attr.at("Name") == names[a]);
+        const auto v = values(arr);
+        joined[names[a]].insert(joined[names[a]].end(), v.begin(), v.end());
+      }
+      const auto c = corners(values(piece->child("Points")->child("DataArray")), values(piece->array("connectivity")));
+      jcorners.insert(jcorners.end(), c.begin(), c.end());
+    }
+    CHECK(cells == std::size_t(s.cell_count()));
+    std::size_t differing = 0;
+    for (const auto& nm : names) differing += joined[nm] == values(wp->array(nm)) ? 0 : 1;
+    CHECK(differing == 0);
+    CHECK(jcorners == wcorners);
+    MESSAGE("block vtu pieces: ", pieces, " pieces, ", cells, " cells, ", differing, " arrays differing");
+  }
+  CHECK_THROWS_WITH_AS(io::write_pvtu_piece(scratch("pieces.vtu"), s, opt, 0, 2),
+                       doctest::Contains("must be a .pvtu file"), invalid_input);
+  CHECK_THROWS_WITH_AS(io::write_pvtu_piece(scratch("pieces.pvtu"), s, opt, 2, 2), doctest::Contains("piece 2 of 2"),
+                       invalid_input);
+}
+
 TEST_CASE("block mid-plane CSV: one row per cut leaf cell, on the plane, exact for fields linear along the normal") {
   two_level_mesh m;
   const auto& s = m.s;

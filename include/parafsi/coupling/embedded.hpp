@@ -266,7 +266,14 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     diag_.work_fluid = diag_.work_structure = diag_.mass_defect = 0;
     diag_.max_through_velocity = 0;
     spread_ready_ = false;
-    if (opt_.impedance > 0) impedance_setup(f.view(), nd);
+    if (opt_.impedance > 0) {
+      if constexpr (requires { f.share_cells(shared_); }) {  // a distributed block mesh: the faces' cells everywhere
+        shared_.clear();
+        for (const auto& fr : faces_) shared_.insert(shared_.end(), {fr.low, fr.high});
+        f.share_cells(shared_);
+      }
+      impedance_setup(f.view(), nd);
+    }
     patch_list_.clear();
     for (const auto& fr : faces_) patch_list_.push_back({fr.high, fr.axis});
   }
@@ -747,6 +754,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   std::vector<index_t> touched_;
   std::vector<double> beta_;
   std::vector<raw_crossing> found_;            ///< find_faces scratch
+  std::vector<index_t> shared_;                ///< the impedance term's cells (share_cells)
   std::vector<fluid::patch_face> patch_list_;  ///< the faces patched in the coming fluid step
   face_space space_{};                         ///< where the faces are found (the last exchange's mesh)
   bool spread_ready_ = false;

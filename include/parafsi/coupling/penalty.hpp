@@ -223,6 +223,12 @@ class penalty : public detail::membrane_coupling<penalty<Porosity>, Porosity, pe
         const stencil sc = loc_.locate(pose_.to_box(x));
         st[std::size_t(c)] = sc;
         if (!sc.inside) continue;
+        if constexpr (block_fluid<Fluid>)  // the same answer on every process of a distributed mesh
+          for (index_t cell : sc.cell)
+            require(f.computed_everywhere(cell / f.stride()), "coupling::penalty: point ", c, " of element ", e,
+                    " reads block ", cell / f.stride(),
+                    ", which not every process computes: on a distributed block mesh the penalty coupling needs the "
+                    "structure's blocks on every process (mpi::block_halo's replicate_finest)");
         const double K = interp(K_, sc);
         const double Ac = geo.area / pts_.nquad(e) / pts_.nquad(e);
         double k = opt_.pfac * K * Ac / sc.h;

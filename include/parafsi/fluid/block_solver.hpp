@@ -360,17 +360,27 @@ class block_solver {
   /// blocks are stale between `gather()` calls: call it before reading cells this process
   /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
   /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
-  /// A coupling reads and writes cells near the structure: the blocks it touches must be
-  /// computed by every process (mpi::block_halo's replicate_finest, with the structure on
-  /// the finest level); a patched face elsewhere stops with a message. With an
-  /// eddy-viscosity closure the wall distance is the caller's, on every block, as without
-  /// a halo.
+  /// A coupling reads and writes cells near the replicated structure. Patched faces
+  /// (coupling::embedded) are processed by every process in list order, each stage after the
+  /// cells they read came from the processes computing them (share_slots), so the structure
+  /// gets the same loads everywhere and every cell its corrections in the same order. A
+  /// coupling that reads the air elsewhere (coupling::penalty's points) needs the blocks it
+  /// touches computed by every process (mpi::block_halo's replicate_finest) and stops with a
+  /// message otherwise. With an eddy-viscosity closure the wall distance is the caller's, on
+  /// every block, as without a halo.
   void set_halo(std::shared_ptr<blocks::halo> h) {
     halo_ = std::move(h);
     gathered_ = true;  // the caller's promise: every process holds the same state
     attach_halo();
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
+  /// Whether every process computes block id (always, when not distributed).
+  bool computed_everywhere(index_t id) const { return !halo_ || halo_->everywhere(id); }
+  /// The conserved state of the listed cells (global indices; any order, repeats allowed)
+  /// from the processes computing them to every process (collective: every process passes
+  /// the same list; a no-op when not distributed). A coupling calls it for the cells it
+  /// reads near the replicated structure (coupling::embedded's impedance term).
+  void share_cells(const std::vector<index_t>& cells) { share_slots(cells, false); }
   /// The blocks this process computes: [first, last) of the tree order.
   /// The blocks this process computes (tree order): all without a halo.
   const std::vector<index_t>& computed_blocks() const noexcept { return computed_; }
@@ -881,9 +891,6 @@ class block_solver {
       const int d = faces[pi].axis;
       require(d >= 0 && d < 3 && c >= 0 && c < stride_ * block_count(), "fluid::block_solver: bad patched face ", pi,
               " (cell ", c, ", axis ", d, ")");
-      require(computes_[std::size_t(c / stride_)], "fluid::block_solver: patched face ", pi, " (cell ", c,
-              ") lies in a block this process does not compute (a distributed mesh must replicate the blocks the "
-              "coupling touches: mpi::block_halo's replicate_finest)");
       const block& b = blocks_[std::size_t(c / stride_)];
       const auto ijk = b.grid.ijk(c % stride_);
       const index_t m = neighbour(c, d, 0);
@@ -891,6 +898,13 @@ class block_solver {
               "fluid::block_solver: patched face ", pi, " (cell ", c, ", axis ", d,
               ") is not between two leaf cells of one level inside the box: the membrane must lie on one level "
               "(refine around it)");
+    }
+    // Distributed: every process processes every face (the replicated structure gets the same
+    // loads everywhere, each cell its corrections in list order), so the cells the faces read
+    // come to every process from the processes computing them first.
+    if (halo_) {
+      patch_zone<one_sided>(faces, zone_);
+      share_slots(zone_, true);
     }
     if constexpr (one_sided) {
       if (blocked_.size() != std::size_t(stride_ * block_count()))
@@ -928,6 +942,75 @@ class block_solver {
         blocked_[std::size_t(f.high)] = 0;
         blocked_[std::size_t(neighbour(f.high, f.axis, 0))] = 0;
       }
+  }
+
+  /// The storage slots (block · stride + local, ghosts included) the processing of the
+  /// patched faces reads: along each face's axis, the high cell and, one-sided, the low cell
+  /// and the cells below and above them (as step_ref walks them), each with the two slots
+  /// either side of it in its block's grid (the kernels' stencils), clipped to the grid;
+  /// else the high cell's slots and the low cell (the patcher's view). Sorted, unique.
+  template <bool OneSided>
+  void patch_zone(std::span<const patch_face> faces, std::vector<index_t>& zone) const {
+    zone.clear();
+    constexpr index_t ng = rectilinear_grid::ghosts;
+    auto around = [&](index_t id, index_t local, int d) {
+      const rectilinear_grid& g = blocks_[std::size_t(id)].grid;
+      const index_t ia = g.ijk(local)[std::size_t(d)], st = g.stride(d);
+      for (index_t k = -2; k <= 2; ++k)
+        if (ia + k >= -ng && ia + k < n_ + ng) zone.push_back(id * stride_ + local + k * st);
+    };
+    for (const patch_face& f : faces) {
+      const index_t c = f.high;
+      const int d = f.axis;
+      around(c / stride_, c % stride_, d);
+      if constexpr (OneSided) {
+        const cell_ref hc{c / stride_, c % stride_,
+                          blocks_[std::size_t(c / stride_)].grid.ijk(c % stride_)[std::size_t(d)], c};
+        const cell_ref lc = step_ref(hc, d, 0), below = step_ref(lc, d, 0), above = step_ref(hc, d, 1);
+        for (const cell_ref& r : {lc, below, above}) around(r.id, r.local, d);
+      } else {
+        zone.push_back(neighbour(c, d, 0));
+      }
+    }
+    std::sort(zone.begin(), zone.end());
+    zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+  }
+
+  /// The conserved state (and with `primitives` the stage's primitives) at storage slots
+  /// (block · stride + local, ghosts included) from the processes computing their blocks
+  /// to every process (collective, the same slots everywhere). Replicated blocks' slots
+  /// are left out: every process holds them.
+  void share_slots(const std::vector<index_t>& slots, bool primitives) {
+    if (!halo_) return;
+    reattach_if_moved();
+    share_block_.clear();
+    share_slot_.clear();
+    for (index_t g : slots) {
+      const index_t id = g / stride_;
+      if (halo_->everywhere(id)) continue;
+      share_block_.push_back(id);
+      share_slot_.push_back(g);
+    }
+    if (share_block_.empty()) return;  // the same on every process
+    const int width = primitives ? 10 : 5;
+    share_vals_.assign(share_slot_.size() * std::size_t(width), 0.0);
+    const auto U = detail::conserved_ptrs(*U_);
+    const auto W = detail::primitive_ptrs(*W_);
+    for (std::size_t i = 0; i < share_slot_.size(); ++i) {
+      if (!computes_[std::size_t(share_block_[i])]) continue;
+      double* v = share_vals_.data() + i * std::size_t(width);
+      for (int f = 0; f < 5; ++f) v[f] = U[f][share_slot_[i]];
+      if (primitives)
+        for (int f = 0; f < 5; ++f) v[5 + f] = W[f][share_slot_[i]];
+    }
+    halo_->gather_items(share_block_, share_vals_, width);
+    for (std::size_t i = 0; i < share_slot_.size(); ++i) {
+      if (computes_[std::size_t(share_block_[i])]) continue;
+      const double* v = share_vals_.data() + i * std::size_t(width);
+      for (int f = 0; f < 5; ++f) U[f][share_slot_[i]] = v[f];
+      if (primitives)
+        for (int f = 0; f < 5; ++f) W[f][share_slot_[i]] = v[5 + f];
+    }
   }
 
   /// A cell as the one-sided reconstruction reads it: the block whose grid holds it (its
@@ -1195,9 +1278,11 @@ class block_solver {
   index_t stride_ = 0;  ///< cells per block in the mesh-wide arrays
   std::unique_ptr<cons_storage> U_, U0_, dU_;
   std::unique_ptr<prim_storage> W_;
-  std::unique_ptr<source_storage> S_;      ///< null until enable_sources
-  std::unique_ptr<turbulence_storage> T_;  ///< with an eddy-viscosity closure
-  std::vector<std::uint8_t> blocked_;      ///< membrane faces' marks (one-sided patches; global_index)
+  std::unique_ptr<source_storage> S_;                     ///< null until enable_sources
+  std::unique_ptr<turbulence_storage> T_;                 ///< with an eddy-viscosity closure
+  std::vector<std::uint8_t> blocked_;                     ///< membrane faces' marks (one-sided patches; global_index)
+  std::vector<index_t> zone_, share_block_, share_slot_;  ///< patch_zone, share_slots scratch
+  std::vector<double> share_vals_;
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   blocks::block_fields U_all_;

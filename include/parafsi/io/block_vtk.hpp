@@ -3,6 +3,10 @@
 /// the counterparts of io/vtk.hpp's write_vts and write_midplane_csv for the box solver.
 ///
 ///   write_vtu(path, block_solver)          every leaf cell → one UnstructuredGrid (.vtu)
+///   write_vtu(path, block_solver, opt, r)  the leaf cells of blocks r = [first, last) only
+///   write_pvtu_piece(path, block_solver, opt, piece, pieces)
+///                                          piece `piece` of `pieces` (one per process) and,
+///                                          from piece 0, the index (.pvtu) that joins them
 ///   write_midplane_csv(path, block_solver) mid-plane slice from the leaf cells → CSV
 ///   vorticity(block_solver)                inertial vorticity of every leaf cell
 ///
@@ -18,6 +22,16 @@
 /// data, as write_vts: `density`, `velocity` (inertial), `pressure` (+ pressure_offset),
 /// `vorticity`; and `level` (the block's refinement level, 0 = root) and `block` (leaf id).
 /// Field data TIME. Encodings and the atomic write as in vtk.hpp.
+///
+/// Pieces (a distributed run, mpi/): the blocks in tree order are cut into `pieces`
+/// contiguous runs of equal length (piece_blocks; block counts differ by at most one, so
+/// the cells do too: every block has n³), and each process writes its run as
+/// `<stem>_<piece>.vtu`, the same file write_vtu would write for those blocks (corners shared
+/// within the piece, each piece its own points; the cell data of the pieces in piece order
+/// are the whole mesh's, value for value). Piece 0 also writes `<stem>.pvtu`, a
+/// PUnstructuredGrid naming the arrays and the pieces (paths relative to the index), which
+/// ParaView opens as one data set (and which a .pvd can list). Every process must hold the
+/// current state of the blocks its piece and their face neighbours (block_solver::gather()).
 ///
 /// Vorticity: the box-frame velocity û = Rᵀu of a leaf cell and of its six face
 /// neighbours (the leaf cells holding the points ξ_c ± h_d e_d, of any level) gives the
@@ -86,11 +100,34 @@ struct lattice_hash {
 
 }  // namespace detail
 
+/// Blocks [first, last) of the tree order; the default (last < 0) is every block.
+struct block_range {
+  index_t first = 0, last = -1;
+};
+
+namespace detail {
+inline block_range whole(block_range r, index_t nb) {
+  if (r.last < 0) r.last = nb;
+  require(r.first >= 0 && r.first <= r.last && r.last <= nb, "io::block_range: blocks [", r.first, ", ", r.last,
+          ") outside the mesh's [0, ", nb, ")");
+  return r;
+}
+}  // namespace detail
+
+/// Piece `piece` of `pieces`: the blocks in tree order cut into `pieces` contiguous runs
+/// whose lengths differ by at most one.
+inline block_range piece_blocks(index_t blocks, int piece, int pieces) {
+  require(pieces >= 1 && piece >= 0 && piece < pieces, "io::piece_blocks: piece ", piece, " of ", pieces);
+  return {blocks * piece / pieces, blocks * (piece + 1) / pieces};
+}
+
 /// Inertial vorticity ω = R (∇_ξ × Rᵀu) of every leaf cell, 3 values per cell, blocks in
 /// tree order, x fastest within a block (see the file comment for the gradient).
+/// With a range r, the cells of blocks [r.first, r.last) only (they read their neighbours).
 template <class F, class Rc, class Tu, class Vi, class Fr, class Ti>
-std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& s) {
+std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& s, block_range r = {}) {
   const index_t n = s.block_cells(), nb = s.block_count();
+  r = detail::whole(r, nb);
   const Eigen::Matrix3d R = s.pose().R;
   std::vector<Eigen::Vector3d> ub(std::size_t(s.cell_count()));
   for (index_t id = 0; id < nb; ++id) {
@@ -102,8 +139,9 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
           ub[detail::leaf_cell(id, n, i, j, k)] = R.transpose() * Eigen::Vector3d(w.u.x, w.u.y, w.u.z);
         }
   }
-  std::vector<double> out(3 * ub.size());
-  for (index_t id = 0; id < nb; ++id) {
+  const std::size_t skip = 3 * detail::leaf_cell(r.first, n, 0, 0, 0);
+  std::vector<double> out(3 * detail::leaf_cell(r.last, n, 0, 0, 0) - skip);
+  for (index_t id = r.first; id < r.last; ++id) {
     const auto& b = s.block_at(id);
     const auto& g = b.grid;
     for (index_t k = 0; k < n; ++k)
@@ -138,9 +176,9 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
             }
           const Eigen::Matrix3d G = B * M.inverse();  // G(a, d) = ∂û_a/∂ξ_d
           const Eigen::Vector3d wi = R * Eigen::Vector3d(G(2, 1) - G(1, 2), G(0, 2) - G(2, 0), G(1, 0) - G(0, 1));
-          out[3 * self] = wi.x();
-          out[3 * self + 1] = wi.y();
-          out[3 * self + 2] = wi.z();
+          out[3 * self - skip] = wi.x();
+          out[3 * self + 1 - skip] = wi.y();
+          out[3 * self + 2 - skip] = wi.z();
         }
   }
   return out;
@@ -148,13 +186,16 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
 
 /// The block mesh's leaf cells as one VTK UnstructuredGrid of hexahedra (see the file
 /// comment: shared inertial corner points, cell data as write_vts plus `level`, `block`).
+/// With a range r, the leaf cells of blocks [r.first, r.last) only (a piece).
 template <class F, class Rc, class Tu, class Vi, class Fr, class Ti>
 void write_vtu(const std::filesystem::path& path, const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& s,
-               const vtk_options& opt = {}) {
-  const index_t n = s.block_cells(), nb = s.block_count();
+               const vtk_options& opt = {}, block_range r = {}) {
+  const index_t n = s.block_cells();
+  r = detail::whole(r, s.block_count());
+  const index_t nb = r.last - r.first;
   const int top = s.tree().finest_level();
   const auto& pose = s.pose();
-  const std::size_t cells = std::size_t(s.cell_count());
+  const std::size_t cells = std::size_t(nb * n * n * n);
   std::vector<double> pts, rho, vel, p;
   std::vector<std::int64_t> conn, offs;
   std::vector<std::int32_t> level, block;
@@ -171,7 +212,7 @@ void write_vtu(const std::filesystem::path& path, const fluid::block_solver<F, R
   std::unordered_map<std::array<std::int64_t, 3>, std::int64_t, detail::lattice_hash> surface;
   const index_t m = n + 1;
   std::vector<std::int64_t> local(std::size_t(m * m * m));
-  for (index_t id = 0; id < nb; ++id) {
+  for (index_t id = r.first; id < r.last; ++id) {
     const auto& b = s.block_at(id);
     const auto& g = b.grid;
     const int shift = top - b.where.level;
@@ -208,7 +249,7 @@ void write_vtu(const std::filesystem::path& path, const fluid::block_solver<F, R
           block.push_back(std::int32_t(id));
         }
   }
-  const std::vector<double> vort = vorticity(s);
+  const std::vector<double> vort = vorticity(s, r);
   const std::vector<std::uint8_t> types(cells, std::uint8_t(12));  // VTK_HEXAHEDRON
   detail::xml_out x(opt.encoding);
   std::string out = detail::vtk_header("UnstructuredGrid");
@@ -226,6 +267,50 @@ void write_vtu(const std::filesystem::path& path, const fluid::block_solver<F, R
   out += "      <CellData Scalars=\"pressure\" Vectors=\"velocity\">\n" + x.s + "      </CellData>\n";
   out += detail::vtu_points_cells_end(x, pts, conn, offs, types);
   io::write_file_atomic(path, out);
+}
+
+/// The piece files of the index `pvtu` (…/stem.pvtu → …/stem_<piece>.vtu).
+inline std::filesystem::path piece_path(const std::filesystem::path& pvtu, int piece) {
+  std::filesystem::path p = pvtu;
+  p.replace_filename(pvtu.stem().string() + "_" + std::to_string(piece) + ".vtu");
+  return p;
+}
+
+/// Piece `piece` of `pieces` of the block mesh (piece_blocks) as piece_path(pvtu, piece),
+/// and from piece 0 the index `pvtu` joining them all (see the file comment). Call it on
+/// every process with its rank and the process count.
+template <class F, class Rc, class Tu, class Vi, class Fr, class Ti>
+void write_pvtu_piece(const std::filesystem::path& pvtu, const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& s,
+                      const vtk_options& opt, int piece, int pieces) {
+  require(pvtu.extension() == ".pvtu", "io::write_pvtu_piece: the index must be a .pvtu file, got '", pvtu.string(),
+          "'");
+  write_vtu(piece_path(pvtu, piece), s, opt, piece_blocks(s.block_count(), piece, pieces));
+  if (piece != 0) return;
+  auto array = [](const char* type, const char* name, int components) {
+    std::string a = "      <PDataArray type=\"";
+    a += type;
+    a += "\"";
+    a += std::string(" Name=\"") + name + "\"";
+    if (components > 1) a += " NumberOfComponents=\"" + std::to_string(components) + "\"";
+    return a + "/>\n";
+  };
+  std::string out = detail::vtk_header("PUnstructuredGrid");
+  out += "  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  out += "    <PCellData Scalars=\"pressure\" Vectors=\"velocity\">\n";
+  const char* f64 = detail::vtk_type_name<double>();
+  const char* i32 = detail::vtk_type_name<std::int32_t>();
+  out += array(f64, "density", 1);
+  out += array(f64, "velocity", 3);
+  out += array(f64, "pressure", 1);
+  out += array(f64, "vorticity", 3);
+  out += array(i32, "level", 1);
+  out += array(i32, "block", 1);
+  out += "    </PCellData>\n    <PPoints>\n";
+  out += array(f64, "Points", 3);
+  out += "    </PPoints>\n";
+  for (int q = 0; q < pieces; ++q) out += "    <Piece Source=\"" + piece_path(pvtu, q).filename().string() + "\"/>\n";
+  out += "  </PUnstructuredGrid>\n</VTKFile>\n";
+  io::write_file_atomic(pvtu, out);
 }
 
 /// Mid-plane slice of the leaf cells as CSV `x,y,z,rho,u,v,w,p,vorticity_normal` (see the

@@ -9,15 +9,17 @@
 /// On `rebuild` (construction, every regrid) each process partitions the leaves' Morton
 /// order by the blocks' costs into one contiguous range per rank (blocks::partition); with
 /// `replicate_finest` the finest level's blocks (every block of a one-level mesh) are left
-/// out of the partition and computed by every process (a coupling's region: the structure is replicated and sees the
-/// same air everywhere, so the loads need no reduction). Then, from the replicated plans, lists for every other rank
+/// out of the partition and computed by every process (a coupling's region, for a coupling that reads the air anywhere
+/// near the structure: coupling::penalty). Then, from the replicated plans, lists for every other rank
 /// the cells it must send there and receive from there: the interior cells the ghost plans of the receiver's blocks
 /// read (blocks::plan_reads) and the register entries its flux corrections read (blocks::correction_reads), sorted by
 /// (block, cell), so sender and receiver agree on the order without sending it. A state exchange is then one message
 /// per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps the
 /// owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read remote
 /// cells, so the messages overlap that work. The register exchange is the same without overlap. The reductions are
-/// MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. Results are
+/// MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. A coupling's
+/// cells (gather_items: the cells the embedded coupling's faces read, each stage) travel by one MPI_Allgatherv, each
+/// from the process computing its block, so every process holds them and processes every face alike. Results are
 /// therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
@@ -83,7 +85,9 @@ class environment {
 struct halo_options {
   /// Every process computes the blocks of the finest level (when the mesh has more than
   /// one): the region where a coupling reads and writes the air when the structure lives on
-  /// the finest level, as in the drop. The other blocks are partitioned.
+  /// the finest level. coupling::penalty needs it; coupling::embedded does not (its faces'
+  /// cells are gathered each stage), and the drop splits every level with it. The other
+  /// blocks are partitioned.
   bool replicate_finest = false;
 };
 
@@ -198,6 +202,43 @@ class block_halo final : public fluid::blocks::halo {
         else v = *o++;
       }
     });
+  }
+
+  bool everywhere(index_t b) const override { return size_ == 1 || everywhere_[std::size_t(b)] != 0; }
+
+  void gather_items(const std::vector<index_t>& item_block, std::vector<double>& values, int width) override {
+    require(values.size() == item_block.size() * std::size_t(width), "mpi::block_halo::gather_items: ", values.size(),
+            " values for ", item_block.size(), " items of width ", width);
+    std::vector<int> counts(std::size_t(size_), 0), displs(std::size_t(size_), 0);
+    for (index_t b : item_block)
+      if (!everywhere(b)) counts[std::size_t(owner_[std::size_t(b)])] += width;
+    index_t total = 0;
+    for (int r = 0; r < size_; ++r) {
+      displs[std::size_t(r)] = int(total);
+      total += counts[std::size_t(r)];
+      require(total < index_t(2000000000), "mpi::block_halo::gather_items: too many values for one message (", total,
+              ")");
+    }
+    gather_.resize(std::size_t(total));
+    auto each = [&](auto&& io) {  // items of partitioned blocks, by owner, in item order
+      std::vector<index_t> at(displs.begin(), displs.end());
+      for (std::size_t i = 0; i < item_block.size(); ++i) {
+        const index_t b = item_block[i];
+        if (everywhere(b)) continue;
+        const int r = owner_[std::size_t(b)];
+        io(r, gather_.data() + at[std::size_t(r)], values.data() + i * std::size_t(width));
+        at[std::size_t(r)] += width;
+      }
+    };
+    each([&](int r, double* g, const double* v) {
+      if (r == rank_) std::copy(v, v + width, g);
+    });
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
+    each([&](int r, const double* g, double* v) {
+      if (r != rank_) std::copy(g, g + width, v);
+    });
+    ++count_.gathers;
+    count_.gathered_bytes += std::int64_t(total) * std::int64_t(sizeof(double));
   }
 
   int rank() const override { return rank_; }

@@ -148,13 +148,15 @@ struct drop_config {
   double fixed_fall = 0;         ///< fixed box: fall length (m) the refined column extends below the start
   std::vector<double> slice_times{0.1, 0.2, 0.3, 0.5, 1, 2, 4, 6};  ///< mid-plane slice times (s)
   std::string out = "out/drop";                                     ///< output directory; empty: no files
-  double vtk_every = 0;         ///< VTK (.vtu structure, .vts fluid, drop.pvd) interval (s), 0 = none
+  double vtk_every = 0;  ///< VTK (.vtu structure, .vts/.vtu fluid or .pvtu pieces, drop.pvd) interval (s), 0 = none
   double checkpoint_every = 0;  ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
   std::string restart;          ///< checkpoint to continue from (same scene and flags)
   bool quiet = false;           ///< no messages on stderr
   /// Block mesh over several processes (set by a distributed program, e.g. with
-  /// mpi::block_halo and replicate_finest: the canopy's level is computed by every process,
-  /// the rest partitioned); every process runs the same drop, process 0 writes the files.
+  /// mpi::block_halo: every level split with the embedded coupling; with the penalty
+  /// coupling replicate_finest, the canopy's level computed by every process); every process
+  /// runs the same drop, process 0 writes the files but for the fluid's VTK pieces (one per
+  /// process, with a .pvtu index).
   std::shared_ptr<fluid::blocks::halo> halo;
 
   /// Throws invalid_input naming a bad field (non-finite numbers included).
@@ -615,16 +617,28 @@ class drop_run {
     const bool ckpt = !c_.out.empty() && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every;
     if (vtk || ckpt) gather_fluid();
     if (vtk) {
+      char nm[64];
+      std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
+      io::vtk_options vo;
+      vo.pressure_offset = p_offset_;
+      // Several processes: each writes its piece of the block mesh, process 0 the .pvtu index.
+      const bool pieces = c_.halo && c_.halo->size() > 1;
+      const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu", ff = c_.out + "/vtk/fluid_" + nm +
+                                                                            (pieces       ? ".pvtu"
+                                                                             : block_mesh ? ".vtu"
+                                                                                          : ".vts");
+      if constexpr (block_mesh)
+        if (pieces) {
+          std::filesystem::create_directories(out() / "vtk");
+          io::write_pvtu_piece(ff, s_.fluid(), vo, c_.halo->rank(), c_.halo->size());
+        }
       if (pvd_) {
-        char nm[64];
-        std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
-        const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu",
-                          ff = c_.out + "/vtk/fluid_" + nm + (block_mesh ? ".vtu" : ".vts");
         io::write_vtu(fs, s_.structure());
-        io::vtk_options vo;
-        vo.pressure_offset = p_offset_;
-        if constexpr (block_mesh) io::write_vtu(ff, s_.fluid(), vo);  // leaf cells as hexahedra
-        else io::write_vts(ff, s_.fluid(), vo);
+        if constexpr (block_mesh) {
+          if (!pieces) io::write_vtu(ff, s_.fluid(), vo);  // leaf cells as hexahedra
+        } else {
+          io::write_vts(ff, s_.fluid(), vo);
+        }
         pvd_->add(s_.time(), ff, 0);
         pvd_->add(s_.time(), fs, 1);
       }

@@ -13,6 +13,9 @@
 ///     the prolongation stencils, blocks/exchange.hpp): `plan_reads` lists them;
 ///   - the face-register entries of finer blocks that its coarse blocks' flux corrections
 ///     read (blocks/flux_correction.hpp): `correction_reads`;
+///   - the cells a coupling's patched faces read (fluid::block_solver's share_slots: the
+///     stage's state and primitives around every face), gathered to every process so that
+///     each processes every face alike and the replicated structure gets the same loads;
 ///   - reductions: the stable step (a maximum, exact) and sums over the mesh, which are
 ///     formed per block and added in block order on every process, so that they do not
 ///     depend on the number of processes.
@@ -184,9 +187,11 @@ struct mesh_view {
 
 /// Message counters of a halo (its own bookkeeping, for the communication model).
 struct halo_counters {
-  std::int64_t messages = 0;   ///< point-to-point messages sent
-  std::int64_t bytes = 0;      ///< bytes in them
-  std::int64_t exchanges = 0;  ///< state exchanges (one per stage)
+  std::int64_t messages = 0;        ///< point-to-point messages sent
+  std::int64_t bytes = 0;           ///< bytes in them
+  std::int64_t exchanges = 0;       ///< state exchanges (one per stage)
+  std::int64_t gathers = 0;         ///< item gathers (gather_items: a coupling's cells, per stage)
+  std::int64_t gathered_bytes = 0;  ///< bytes they assembled on every process
 };
 
 /// The interface the block solver calls at the points of a stage where another process's
@@ -216,6 +221,13 @@ class halo {
   /// per_block holds `width` values per block, filled for the blocks this process computes:
   /// fill the rest from their owners.
   virtual void gather_blocks(std::vector<double>& per_block, int width) = 0;
+  /// Whether every process computes block b (a replicated block).
+  virtual bool everywhere(index_t b) const = 0;
+  /// Items held by blocks: item_block[i] is the block holding item i, values holds `width`
+  /// values per item, filled for the items of the blocks this process owns (not the
+  /// replicated ones): fill the others' from their owners; the items of replicated blocks
+  /// are left as they are. Every process passes the same item_block.
+  virtual void gather_items(const std::vector<index_t>& item_block, std::vector<double>& values, int width) = 0;
   /// This process's rank and the number of processes.
   virtual int rank() const = 0;
   virtual int size() const = 0;

@@ -367,7 +367,7 @@ class block_solver {
   /// coupling that reads the air elsewhere (coupling::penalty's points) needs the blocks it
   /// touches computed by every process (mpi::block_halo's replicate_finest) and stops with a
   /// message otherwise. With an eddy-viscosity closure the wall distance is the caller's, on
-  /// every block, as without a halo.
+  /// the blocks this process computes (computed_blocks(), ghosts included).
   void set_halo(std::shared_ptr<blocks::halo> h) {
     halo_ = std::move(h);
     gathered_ = true;  // the caller's promise: every process holds the same state
@@ -603,7 +603,9 @@ class block_solver {
     for (bool merged = true; merged;) {
       merged = false;
       for (const auto& q : std::vector<blocks::location>(next.leaves())) {
-        if (q.level == 0 || !next.is_leaf(q)) continue;
+        // Each parent once, at its first child: its 8 children, when all are leaves, are
+        // consecutive in the Morton order, so the later ones would ask the same question.
+        if (q.level == 0 || !(q.l[0] % 2 == 0 && q.l[1] % 2 == 0 && q.l[2] % 2 == 0) || !next.is_leaf(q)) continue;
         const blocks::location p = q.parent();
         bool all = true;
         for (int c = 0; c < 8 && all; ++c) all = next.is_leaf(p.child(c)) && want(p.child(c)) < p.level + 1;

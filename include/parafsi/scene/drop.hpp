@@ -712,10 +712,25 @@ class drop_run {
       for (index_t i = 0; i < nd.size(); ++i) wall_points_[std::size_t(i)] = Rt * (nd.position(i) - f.pose().X);
       const double reach = ml.c_l * ml.ref_length / ml.kappa;
       if constexpr (block_mesh) {
-        // Each block's cells and ghosts (a ghost's eddy viscosity is then its neighbour's).
-        parallel::for_range(0, f.block_count(), [&](index_t id) {
+        // Each computed block's cells and ghosts (a ghost's eddy viscosity is then its
+        // neighbour's); over MPI the blocks this process computes. On a block, d_w matters
+        // only where κ d_w < min(C_l L_ref, C_Δ Δ) with the block's Δ = (h_x h_y h_z)^(1/3)
+        // (its widths, ghosts included, at their largest): beyond that reach the closure's
+        // l_m is its cap either way, so the nearer reach (a margin of 1e-9 over rounding)
+        // gives the same eddy viscosity, bit for bit, at a fraction of the cost on fine blocks.
+        const std::vector<index_t>& ids = f.computed_blocks();
+        parallel::for_range(0, index_t(ids.size()), [&](index_t k) {
+          const index_t id = ids[std::size_t(k)];
           const auto& g = f.block_at(id).grid;
-          fluid::distance_to_points(g, wall_points_, reach,
+          double hmax[3];
+          for (int d = 0; d < 3; ++d) {
+            const double* w = g.widths(d);
+            hmax[d] = *std::max_element(w - fluid::rectilinear_grid::ghosts,
+                                        w + g.n(d) + fluid::rectilinear_grid::ghosts);
+          }
+          const double cap = std::min(ml.c_l * ml.ref_length, ml.c_delta * std::cbrt(hmax[0] * hmax[1] * hmax[2]));
+          const double block_reach = std::min(reach, cap / ml.kappa * (1.0 + 1e-9));
+          fluid::distance_to_points(g, wall_points_, block_reach,
                                     std::span<double>(f.wall_distance(id), std::size_t(g.total_cells())), true);
         });
       } else {

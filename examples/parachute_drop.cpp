@@ -30,9 +30,10 @@
 // summary row on stdout at the end.
 //
 // Under MPI (built with parafsi::mpi when MPI is found): `mpirun -np N parachute_drop
-// --mesh blocks ...` with the same flags splits the block mesh over the N processes (the
-// canopy's finest level computed by every process, the rest partitioned; docs/guide_mpi.md);
-// process 0 prints and writes the files, which are those of one process bit for bit.
+// --mesh blocks ...` with the same flags splits every level of the block mesh over the N
+// processes (with --coupling penalty the canopy's finest level is computed by every
+// process; docs/guide_mpi.md); process 0 prints and writes the files, which are those of
+// one process bit for bit, and each process writes its piece of the fluid VTK (.pvtu index).
 //
 // The run is scene::run_drop (include/parafsi/scene/drop.hpp); the flags bind directly to
 // the fields of scene::drop_config, whose defaults are the program's. Every floating

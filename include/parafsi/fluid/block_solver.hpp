@@ -381,7 +381,6 @@ class block_solver {
   /// the same list; a no-op when not distributed). A coupling calls it for the cells it
   /// reads near the replicated structure (coupling::embedded's impedance term).
   void share_cells(const std::vector<index_t>& cells) { share_slots(cells, false); }
-  /// The blocks this process computes: [first, last) of the tree order.
   /// The blocks this process computes (tree order): all without a halo.
   const std::vector<index_t>& computed_blocks() const noexcept { return computed_; }
   /// Every block's interior cells from its owner to every process (collective; a no-op
@@ -603,8 +602,10 @@ class block_solver {
     for (bool merged = true; merged;) {
       merged = false;
       for (const auto& q : std::vector<blocks::location>(next.leaves())) {
-        // Each parent once, at its first child: its 8 children, when all are leaves, are
-        // consecutive in the Morton order, so the later ones would ask the same question.
+        // Each parent once per pass, at its first child (its 8 children, when all are leaves,
+        // are consecutive in the Morton order). A parent that a merge beside it makes
+        // mergeable later in the pass waits for the next pass; merges only enable merges and
+        // the loop runs until none happens, so the tree is the same.
         if (q.level == 0 || !(q.l[0] % 2 == 0 && q.l[1] % 2 == 0 && q.l[2] % 2 == 0) || !next.is_leaf(q)) continue;
         const blocks::location p = q.parent();
         bool all = true;

@@ -10,6 +10,9 @@
 ///                                      takes the difference as its load).
 /// The solver computes the regular flux first and corrects the two cells' rates, per RK
 /// stage, serially in list order; the context names the stage and the patch index.
+/// On a block mesh split over processes (block_solver::set_halo) every process calls
+/// patch() for every face, and the view is current only at each face's two cells (fc.low,
+/// fc.high): a patcher must read nothing else of the air.
 #pragma once
 #include <concepts>
 #include <span>

@@ -611,7 +611,8 @@ class drop_run {
   }
 
   /// VTK files and the checkpoint when their instants are reached (on every process: a
-  /// distributed mesh is gathered first, and process 0 writes).
+  /// distributed mesh is gathered first; process 0 writes, but for the fluid's VTK pieces,
+  /// one per process).
   void write_outputs() {
     const bool vtk = !c_.out.empty() && c_.vtk_every > 0 && s_.time() >= next_vtk_ - 1e-9 * c_.history_every;
     const bool ckpt = !c_.out.empty() && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every;
@@ -622,7 +623,7 @@ class drop_run {
       io::vtk_options vo;
       vo.pressure_offset = p_offset_;
       // Several processes: each writes its piece of the block mesh, process 0 the .pvtu index.
-      const bool pieces = c_.halo && c_.halo->size() > 1;
+      const bool pieces = block_mesh && c_.halo && c_.halo->size() > 1;
       const std::string fs = c_.out + "/vtk/structure_" + nm + ".vtu", ff = c_.out + "/vtk/fluid_" + nm +
                                                                             (pieces       ? ".pvtu"
                                                                              : block_mesh ? ".vtu"
@@ -700,8 +701,10 @@ class drop_run {
   }
 
   /// Mixing length: d_w from the structure's nodes (canopy and lines, box coordinates of
-  /// now) within reach C_l L_ref/κ, where κ d_w can be the closure's smallest length
-  /// (fluid/wall_distance.hpp); refreshed before every step.
+  /// now) within reach C_l L_ref/κ (on a block, min(C_l L_ref, C_Δ Δ)/κ), where κ d_w can
+  /// be the closure's smallest length (fluid/wall_distance.hpp); refreshed before every
+  /// step, on the blocks this process computes. (A checkpoint's wall distance is therefore
+  /// not the same bytes for every process count; it is refilled before the next step.)
   void update_wall_distance() {
     if constexpr (Fluid::needs_wall_distance) {
       auto& f = s_.fluid();

@@ -6,9 +6,9 @@
 /// for every block (the mesh's metadata is small; the storage is replicated for now, see
 /// docs/guide_mpi.md), but computes only the blocks it owns: a contiguous range of the
 /// leaves' Morton order, cut by cost (`partition`), and the blocks every process computes
-/// (optionally: the region a coupling reads and writes, so that the replicated structure
-/// sees the same air on every process). A stage of the block solver then reads three
-/// kinds of data another process computed:
+/// (optionally, e.g. for coupling::penalty: the finest level, where a coupling reads and
+/// writes the air). A stage of the block solver then reads four kinds of data another
+/// process computed:
 ///   - the interior cells that its own blocks' ghost plans read (copies, restrictions and
 ///     the prolongation stencils, blocks/exchange.hpp): `plan_reads` lists them;
 ///   - the face-register entries of finer blocks that its coarse blocks' flux corrections

@@ -209,31 +209,25 @@ class block_halo final : public fluid::blocks::halo {
   void gather_items(const std::vector<index_t>& item_block, std::vector<double>& values, int width) override {
     require(values.size() == item_block.size() * std::size_t(width), "mpi::block_halo::gather_items: ", values.size(),
             " values for ", item_block.size(), " items of width ", width);
-    std::vector<int> counts(std::size_t(size_), 0), displs(std::size_t(size_), 0);
+    counts_.assign(std::size_t(size_), 0);
     for (index_t b : item_block)
-      if (!everywhere(b)) counts[std::size_t(owner_[std::size_t(b)])] += width;
-    index_t total = 0;
-    for (int r = 0; r < size_; ++r) {
-      displs[std::size_t(r)] = int(total);
-      total += counts[std::size_t(r)];
-      require(total < index_t(2000000000), "mpi::block_halo::gather_items: too many values for one message (", total,
-              ")");
-    }
-    gather_.resize(std::size_t(total));
-    auto each = [&](auto&& io) {  // items of partitioned blocks, by owner, in item order
-      std::vector<index_t> at(displs.begin(), displs.end());
+      if (!everywhere(b)) counts_[std::size_t(owner_[std::size_t(b)])] += width;
+    // Items of partitioned blocks, by owner, in item order: io(rank, gathered, item values).
+    auto each = [&](auto&& io) {
+      at_.assign(displs_.begin(), displs_.end());
       for (std::size_t i = 0; i < item_block.size(); ++i) {
         const index_t b = item_block[i];
         if (everywhere(b)) continue;
         const int r = owner_[std::size_t(b)];
-        io(r, gather_.data() + at[std::size_t(r)], values.data() + i * std::size_t(width));
-        at[std::size_t(r)] += width;
+        io(r, gather_.data() + at_[std::size_t(r)], values.data() + i * std::size_t(width));
+        at_[std::size_t(r)] += width;
       }
     };
-    each([&](int r, double* g, const double* v) {
-      if (r == rank_) std::copy(v, v + width, g);
+    const index_t total = allgather([&] {
+      each([&](int r, double* g, const double* v) {
+        if (r == rank_) std::copy(v, v + width, g);
+      });
     });
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
     each([&](int r, const double* g, double* v) {
       if (r != rank_) std::copy(g, g + width, v);
     });
@@ -257,31 +251,48 @@ class block_halo final : public fluid::blocks::halo {
   /// io(block, buffer, pack) packs (pack true) or unpacks the block's values.
   template <class IO>
   void gather_by_owner(index_t per, IO&& io) {
-    std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_));
-    index_t total = 0;
-    for (int r = 0; r < size_; ++r) {
-      const index_t count = per * index_t(owned_[std::size_t(r)].size());
-      require(total + count < index_t(2000000000), "mpi::block_halo: the mesh is too large for one gather message (",
-              total + count, " values)");
-      displs[std::size_t(r)] = int(total);
-      counts[std::size_t(r)] = int(count);
-      total += count;
-    }
-    gather_.resize(std::size_t(total));
-    double* mine = gather_.data() + displs[std::size_t(rank_)];
-    for (index_t b : owned_[std::size_t(rank_)]) {
-      io(b, mine, true);
-      mine += per;
-    }
-    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
+    counts_.assign(std::size_t(size_), 0);
+    for (int r = 0; r < size_; ++r) counts_[std::size_t(r)] = per * index_t(owned_[std::size_t(r)].size());
+    allgather([&] {
+      double* mine = gather_.data() + displs_[std::size_t(rank_)];
+      for (index_t b : owned_[std::size_t(rank_)]) {
+        io(b, mine, true);
+        mine += per;
+      }
+    });
     for (int r = 0; r < size_; ++r) {
       if (r == rank_) continue;
-      double* o = gather_.data() + displs[std::size_t(r)];
+      double* o = gather_.data() + displs_[std::size_t(r)];
       for (index_t b : owned_[std::size_t(r)]) {
         io(b, o, false);
         o += per;
       }
     }
+  }
+
+  /// MPI_Allgatherv into gather_ of counts_[r] values from each rank r, in rank order:
+  /// sets displs_, sizes gather_, lets pack() fill this rank's part, then gathers in place.
+  /// Returns the number of values.
+  template <class Pack>
+  index_t allgather(Pack&& pack) {
+    displs_.assign(std::size_t(size_), 0);
+    mpi_counts_.assign(std::size_t(size_), 0);
+    mpi_displs_.assign(std::size_t(size_), 0);
+    index_t total = 0;
+    for (int r = 0; r < size_; ++r) {
+      const index_t count = counts_[std::size_t(r)];
+      require(total + count < index_t(2000000000), "mpi::block_halo: too many values for one gather message (",
+              total + count, ")");
+      displs_[std::size_t(r)] = total;
+      mpi_displs_[std::size_t(r)] = int(total);
+      mpi_counts_[std::size_t(r)] = int(count);
+      total += count;
+    }
+    gather_.resize(std::size_t(total));
+    pack();
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, gather_.data(), mpi_counts_.data(), mpi_displs_.data(),
+                   MPI_DOUBLE, comm_);
+    return total;
   }
 
   /// The conserved value f of a cell (the state exchange's storage).
@@ -344,6 +355,8 @@ class block_halo final : public fluid::blocks::halo {
   lists state_send_, state_recv_, reg_send_, reg_recv_;
   std::vector<std::vector<double>> sbuf_, rbuf_;
   std::vector<double> gather_;
+  std::vector<index_t> counts_, displs_, at_;  ///< allgather: values per rank, offsets; gather_items' cursor
+  std::vector<int> mpi_counts_, mpi_displs_;
   std::vector<MPI_Request> reqs_;
   fluid::blocks::halo_counters count_;
 };

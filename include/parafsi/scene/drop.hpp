@@ -713,14 +713,11 @@ class drop_run {
       const Eigen::Matrix3d Rt = f.pose().R.transpose();
       wall_points_.resize(std::size_t(nd.size()));
       for (index_t i = 0; i < nd.size(); ++i) wall_points_[std::size_t(i)] = Rt * (nd.position(i) - f.pose().X);
-      const double reach = ml.c_l * ml.ref_length / ml.kappa;
       if constexpr (block_mesh) {
         // Each computed block's cells and ghosts (a ghost's eddy viscosity is then its
-        // neighbour's); over MPI the blocks this process computes. On a block, d_w matters
-        // only where κ d_w < min(C_l L_ref, C_Δ Δ) with the block's Δ = (h_x h_y h_z)^(1/3)
-        // (its widths, ghosts included, at their largest): beyond that reach the closure's
-        // l_m is its cap either way, so the nearer reach (a margin of 1e-9 over rounding)
-        // gives the same eddy viscosity, bit for bit, at a fraction of the cost on fine blocks.
+        // neighbour's); over MPI the blocks this process computes. The reach is the
+        // closure's for the block's Δ = (h_x h_y h_z)^(1/3) (its widths, ghosts included, at
+        // their largest): the same eddy viscosity, at a fraction of the cost on fine blocks.
         const std::vector<index_t>& ids = f.computed_blocks();
         parallel::for_range(0, index_t(ids.size()), [&](index_t k) {
           const index_t id = ids[std::size_t(k)];
@@ -731,13 +728,11 @@ class drop_run {
             hmax[d] = *std::max_element(w - fluid::rectilinear_grid::ghosts,
                                         w + g.n(d) + fluid::rectilinear_grid::ghosts);
           }
-          const double cap = std::min(ml.c_l * ml.ref_length, ml.c_delta * std::cbrt(hmax[0] * hmax[1] * hmax[2]));
-          const double block_reach = std::min(reach, cap / ml.kappa * (1.0 + 1e-9));
-          fluid::distance_to_points(g, wall_points_, block_reach,
+          fluid::distance_to_points(g, wall_points_, ml.wall_reach(std::cbrt(hmax[0] * hmax[1] * hmax[2])),
                                     std::span<double>(f.wall_distance(id), std::size_t(g.total_cells())), true);
         });
       } else {
-        fluid::distance_to_points(f.grid(), wall_points_, reach,
+        fluid::distance_to_points(f.grid(), wall_points_, ml.wall_reach(std::numeric_limits<double>::infinity()),
                                   std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())));
       }
     }

@@ -9,6 +9,8 @@
 /// References: Prandtl L. (1925) ZAMM 5:136; Wilcox D.C., Turbulence Modeling for CFD,
 ///   3rd ed., ch. 3; Pope S.B. (2000) Turbulent Flows, §10.3.
 #pragma once
+#include <algorithm>
+
 #include "../../core/error.hpp"
 #include "../../core/policy.hpp"
 #include "../../core/simd.hpp"
@@ -30,6 +32,14 @@ struct prandtl_mixing_length {
   void validate() const {
     require(kappa > 0 && c_l > 0 && ref_length > 0 && c_delta > 0,
             "turbulence::prandtl_mixing_length: constants must be positive");
+  }
+  /// The wall distance beyond which d_w no longer sets l_m in cells whose grid scale Δ is
+  /// at most `delta`: min(C_l L_ref, C_Δ delta)/κ (1e-9 over it where the grid cap binds,
+  /// for rounding), so a distance field may stop there (1e30 beyond) and give the same μ_t
+  /// bit for bit; C_l L_ref/κ for delta = ∞.
+  double wall_reach(double delta) const noexcept {
+    const double reach = c_l * ref_length / kappa;
+    return std::min(reach, std::min(c_l * ref_length, c_delta * delta) / kappa * (1.0 + 1e-9));
   }
   template <class V>
   PARAFSI_INLINE V eddy_viscosity(const V& rho, const V& S_norm, const V& delta,

@@ -731,9 +731,13 @@ class block_solver {
       for (index_t id = 0; id < block_count(); ++id) computed_.push_back(id);
     computes_.assign(blocks_.size(), 0);
     for (index_t id : computed_) computes_[std::size_t(id)] = 1;
-    local_ids_.clear();
-    remote_ids_.clear();
-    for (index_t id : computed_) (halo_ && halo_->reads_remote(id) ? remote_ids_ : local_ids_).push_back(id);
+    for (auto* v : {&local_ids_, &remote_send_ids_, &remote_ids_, &correct_local_ids_, &correct_remote_ids_})
+      v->clear();
+    for (index_t id : computed_) {
+      if (!halo_ || !halo_->reads_remote(id)) local_ids_.push_back(id);
+      else (halo_->sends_registers(id) ? remote_send_ids_ : remote_ids_).push_back(id);
+      (halo_ && halo_->corrects_remote(id) ? correct_remote_ids_ : correct_local_ids_).push_back(id);
+    }
   }
 
   /// The halo holds pointers into this object (its tree, plans and storage table): after a
@@ -745,7 +749,12 @@ class block_solver {
   /// f(id) for every block this process computes, in parallel over blocks.
   template <class F>
   void for_computed(F&& f) const {
-    detail::par_for(threaded_, 0, index_t(computed_.size()), [&](index_t k) { f(computed_[std::size_t(k)]); });
+    for_ids(computed_, f);
+  }
+  /// f(id) for the blocks in ids, in parallel over blocks.
+  template <class F>
+  void for_ids(const std::vector<index_t>& ids, F&& f) const {
+    detail::par_for(threaded_, 0, index_t(ids.size()), [&](index_t k) { f(ids[std::size_t(k)]); });
   }
 
   void allocate_sources() {
@@ -799,23 +808,33 @@ class block_solver {
       for (auto& vs : visc_bufs_)
         if (vs.size() < cells) vs.resize(cells, 0.0);
     }
-    // Ghosts, then the sweeps, of the owned blocks in `ids`.
+    // Ghosts, then the sweeps, of the owned blocks in `ids`; the coarse–fine corrections.
     auto ghosts_and_sweeps = [&](const std::vector<index_t>& ids) {
       timed(times_.boundaries, [&] { fill_ghosts(t, ids); });
-      timed(times_.fluxes, [&] {
-        detail::par_for(threaded_, 0, index_t(ids.size()), [&](index_t k) { sweep_block(ids[std::size_t(k)], geo); });
-      });
+      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { sweep_block(id, geo); }); });
     };
-    if (halo_) {  // the blocks with local ghosts while the messages travel, then the others
+    auto corrections = [&](const std::vector<index_t>& ids) {
+      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { correct_fluxes(id); }); });
+    };
+    if (halo_) {
+      // Each exchange travels while blocks that do not wait for it are worked on: the
+      // state, while the blocks with local ghosts are swept; the registers (leaving once
+      // the blocks other processes read them of are swept), while the remaining blocks are
+      // swept and the corrections that read only local registers are made. Every block
+      // gets the same operations as on one process, so the order changes no bit.
       timed(times_.exchange, [&] { halo_->begin_state(); });
       ghosts_and_sweeps(local_ids_);
       timed(times_.exchange, [&] { halo_->end_state(); });
+      ghosts_and_sweeps(remote_send_ids_);
+      timed(times_.exchange, [&] { halo_->begin_registers(); });
       ghosts_and_sweeps(remote_ids_);
+      corrections(correct_local_ids_);
+      timed(times_.exchange, [&] { halo_->end_registers(); });
+      corrections(correct_remote_ids_);
     } else {
       ghosts_and_sweeps(local_ids_);
+      corrections(correct_local_ids_);
     }
-    if (halo_) timed(times_.exchange, [&] { halo_->exchange_registers(); });
-    timed(times_.fluxes, [&] { for_computed([&](index_t id) { correct_fluxes(id); }); });
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
       timed(times_.sources, [&] { for_computed([&](index_t id) { add_sources(id); }); });
@@ -1297,12 +1316,17 @@ class block_solver {
   cons<double> sponge_target_{1.18, {0, 0, 0}, 101325.0 / 0.4};
   phase_times times_{};
   bool threaded_ = false;
-  std::shared_ptr<blocks::halo> halo_;           ///< null: this process computes every block
-  const block_solver* attached_to_ = nullptr;    ///< the object the halo's pointers point into
-  bool gathered_ = true;                         ///< every block's state is current on this process (set by gather())
-  std::vector<index_t> computed_;                ///< the blocks this process computes (tree order)
-  std::vector<char> computes_;                   ///< per block: whether this process computes it
-  std::vector<index_t> local_ids_, remote_ids_;  ///< owned blocks whose ghosts are all local / read remote cells
+  std::shared_ptr<blocks::halo> halo_;         ///< null: this process computes every block
+  const block_solver* attached_to_ = nullptr;  ///< the object the halo's pointers point into
+  bool gathered_ = true;                       ///< every block's state is current on this process (set by gather())
+  std::vector<index_t> computed_;              ///< the blocks this process computes (tree order)
+  std::vector<char> computes_;                 ///< per block: whether this process computes it
+  // The blocks this process computes, by what they wait for in a stage (attach_halo):
+  std::vector<index_t> local_ids_;           ///< ghosts all local (every block without a halo)
+  std::vector<index_t> remote_send_ids_;     ///< ghosts read remote cells; other processes read their registers
+  std::vector<index_t> remote_ids_;          ///< ghosts read remote cells; their registers stay here
+  std::vector<index_t> correct_local_ids_;   ///< corrections read local registers only (all without a halo)
+  std::vector<index_t> correct_remote_ids_;  ///< corrections read remote registers
 };
 
 template <policy... Ps>

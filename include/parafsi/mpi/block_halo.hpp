@@ -16,11 +16,13 @@
 /// (block, cell), so sender and receiver agree on the order without sending it. A state exchange is then one message
 /// per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps the
 /// owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read remote
-/// cells, so the messages overlap that work. The register exchange is the same without overlap. The reductions are
-/// MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. A coupling's
-/// cells (gather_items: the cells the embedded coupling's faces read, each stage) travel by one MPI_Allgatherv, each
-/// from the process computing its block, so every process holds them and processes every face alike. Results are
-/// therefore bitwise those of one process.
+/// cells, so the messages overlap that work. The register exchange likewise: its messages leave once the blocks whose
+/// registers other ranks read are swept (begin_registers) and travel while the solver sweeps the remaining blocks and
+/// corrects the coarse blocks whose corrections read only this rank's registers (end_registers waits). The reductions
+/// are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. A
+/// coupling's cells (gather_items: the cells the embedded coupling's faces read, each stage) travel by one
+/// MPI_Allgatherv, each from the process computing its block, so every process holds them and processes every face
+/// alike. Results are therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
 /// block's arrays), and a gather-free regrid.
@@ -147,13 +149,20 @@ class block_halo final : public fluid::blocks::halo {
     split(regs, reg_send_, reg_recv_);
     std::vector<index_t> computed;
     remote_reader_.assign(std::size_t(nb), 0);
+    remote_corrector_.assign(std::size_t(nb), 0);
+    register_sender_.assign(std::size_t(nb), 0);
     for (index_t b = 0; b < nb; ++b) {
       if (!computes(b)) continue;
       computed.push_back(b);
       fluid::blocks::plan_reads((*m_.plan)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
         if (!computes(c.block)) remote_reader_[std::size_t(b)] = 1;
       });
+      fluid::blocks::correction_reads((*m_.corrections)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
+        if (!computes(c.block)) remote_corrector_[std::size_t(b)] = 1;
+      });
     }
+    for (const auto& items : reg_send_)
+      for (const cell_ref& c : items) register_sender_[std::size_t(c.block)] = 1;
     return computed;
   }
 
@@ -164,11 +173,10 @@ class block_halo final : public fluid::blocks::halo {
   void end_state() override { end(state_recv_, 5, state_at{this}); }
   bool reads_remote(index_t id) const override { return remote_reader_[std::size_t(id)] != 0; }
 
-  void exchange_registers() override {
-    auto at = [this](const cell_ref& c, int) -> double& { return m_.registers[std::size_t(c.block)][c.cell]; };
-    begin(reg_send_, reg_recv_, 1, at);
-    end(reg_recv_, 1, at);
-  }
+  bool sends_registers(index_t id) const override { return register_sender_[std::size_t(id)] != 0; }
+  bool corrects_remote(index_t id) const override { return remote_corrector_[std::size_t(id)] != 0; }
+  void begin_registers() override { begin(reg_send_, reg_recv_, 1, register_at{this}); }
+  void end_registers() override { end(reg_recv_, 1, register_at{this}); }
 
   void gather_state() override {
     const index_t n = m_.n;
@@ -300,6 +308,11 @@ class block_halo final : public fluid::blocks::halo {
     const block_halo* h;
     double& operator()(const cell_ref& c, int f) const { return (*h->m_.U)[std::size_t(c.block)][f][c.cell]; }
   };
+  /// A face-register entry (the register exchange's storage; c.cell is the offset in it).
+  struct register_at {
+    const block_halo* h;
+    double& operator()(const cell_ref& c, int) const { return h->m_.registers[std::size_t(c.block)][c.cell]; }
+  };
 
   /// One message per peer each way: post the receives, pack and send (begin); wait and
   /// unpack (end). width values per listed item, at(item, k) the storage of value k.
@@ -352,6 +365,8 @@ class block_halo final : public fluid::blocks::halo {
   std::vector<char> everywhere_;             ///< per block: computed by every process
   std::vector<std::vector<index_t>> owned_;  ///< per rank: its partitioned blocks
   std::vector<char> remote_reader_;          ///< per block: its ghost plan reads another process's cells
+  std::vector<char> remote_corrector_;       ///< per block: its flux corrections read another process's registers
+  std::vector<char> register_sender_;        ///< per block: another process reads its register
   lists state_send_, state_recv_, reg_send_, reg_recv_;
   std::vector<std::vector<double>> sbuf_, rbuf_;
   std::vector<double> gather_;

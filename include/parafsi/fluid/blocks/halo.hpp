@@ -211,8 +211,17 @@ class halo {
   virtual void end_state() = 0;
   /// Whether the ghost plan of computed block `id` reads cells this process does not compute.
   virtual bool reads_remote(index_t id) const = 0;
-  /// Bring the finer blocks' register entries the owned coarse blocks' corrections read.
-  virtual void exchange_registers() = 0;
+  /// Whether computed block `id` holds register entries another process's corrections read.
+  virtual bool sends_registers(index_t id) const = 0;
+  /// Whether the flux corrections of computed block `id` read register entries of blocks
+  /// this process does not compute.
+  virtual bool corrects_remote(index_t id) const = 0;
+  /// Bring the finer blocks' register entries the owned coarse blocks' corrections read,
+  /// in two halves: begin_registers() (once every block with sends_registers(id) is swept)
+  /// starts the messages, end_registers() waits and stores them; between the two the solver
+  /// sweeps the blocks that send nothing and corrects those with corrects_remote(id) false.
+  virtual void begin_registers() = 0;
+  virtual void end_registers() = 0;
   /// Every block's interior cells (and eddy viscosity, with a closure) to every process
   /// (before a regrid, a checkpoint, output).
   virtual void gather_state() = 0;

@@ -8,6 +8,8 @@
 //   air's momentum change equals minus the structure's and its energy change the work of
 //   the membrane faces, to round-off. The piston and screen across level boundaries are in
 //   test_coupling_blocks_duct.cpp.
+// - Recorded faces: the embedded coupling's faces solved apart and replayed in list order
+//   (fluid::recording_face_patcher) give the bits of the face-by-face patch.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -141,4 +143,70 @@ TEST_CASE("one-sided embedded coupling on one level of blocks reproduces the box
   CHECK(worst_x < 1e-12);
   CHECK(worst_f < 1e-14);
   CHECK(apart > 1e-6);
+}
+
+namespace {
+/// The embedded coupling without its solve/record split: the block solver then patches its
+/// faces one by one through patch() (the path every other patcher takes).
+template <class Porosity, bool OneSided>
+struct per_face_embedded : pf::coupling::embedded<Porosity, OneSided> {
+  using pf::coupling::embedded<Porosity, OneSided>::embedded;
+  double solve_patch(const pf::fluid::face_context&, const pf::fluid::view&, pf::fluid::cons<double>&,
+                     pf::fluid::cons<double>&) const = delete;
+};
+}  // namespace
+
+TEST_CASE_TEMPLATE("embedded faces solved apart and replayed in list order: the bits of the face-by-face patch", P,
+                   pf::porosity::impermeable, pf::porosity::ergun) {
+  // Three levels (the membrane on the finest), one-sided cells, 30 steps: every node
+  // velocity, every cell and the coupling's sums equal bit for bit. The recorded run solves
+  // its faces (and runs its block loops) on two threads, the face-by-face one on one.
+  const int threads0 = pf::parallel::max_threads();
+  const P por = [] {
+    if constexpr (std::is_same_v<P, pf::porosity::ergun>) return pf::porosity::ergun{1e7, 1e4, 1e-4};
+    else return P{};
+  }();
+  static_assert(pf::fluid::recording_face_patcher<pf::coupling::embedded<P, true>>);
+  static_assert(!pf::fluid::recording_face_patcher<per_face_embedded<P, true>>);
+  auto rec = blocks_patch(2, pf::coupling::embedded<P, true>{por});
+  auto one = blocks_patch(2, per_face_embedded<P, true>{por});
+  rec.fluid().set_threading(true);
+  double moved = 0;
+  for (int n = 0; n < 30; ++n) {
+    pf::parallel::set_threads(2);
+    const double dt = rec.stable_dt(0.5);
+    rec.step(dt);
+    pf::parallel::set_threads(1);
+    one.step(dt);
+  }
+  pf::parallel::set_threads(threads0);
+  long differ = 0;
+  const auto& a = rec.structure().node_set();
+  const auto& b = one.structure().node_set();
+  for (pf::index_t i = 0; i < a.size(); ++i) {
+    differ += a.velocity(i) != b.velocity(i) || a.position(i) != b.position(i);
+    moved = std::max(moved, (a.velocity(i) - Eigen::Vector3d{4.0, 1.0, -0.5}).norm());
+  }
+  const auto va = rec.fluid().view(), vb = one.fluid().view();
+  const fb::block_index at{rec.fluid().block_cells()};
+  long cells = 0;
+  for (pf::index_t id = 0; id < rec.fluid().block_count(); ++id)
+    for (pf::index_t k = 0; k < at.n; ++k)
+      for (pf::index_t j = 0; j < at.n; ++j)
+        for (pf::index_t i = 0; i < at.n; ++i) {
+          const pf::index_t c = rec.fluid().global_index(id, at(i, j, k));
+          ++cells;
+          differ += va.rho[c] != vb.rho[c] || va.mx[c] != vb.mx[c] || va.my[c] != vb.my[c] || va.mz[c] != vb.mz[c] ||
+                    va.E[c] != vb.E[c];
+        }
+  const auto& da = rec.coupling().diagnostics();
+  const auto& db = one.coupling().diagnostics();
+  MESSAGE(da.faces, " faces, ", cells, " cells, nodes moved by up to ", moved, " m/s; values differing: ", differ);
+  CHECK(da.faces > 10);
+  CHECK(cells > 0);
+  CHECK(moved > 1e-3);  // the coupling acted
+  CHECK(differ == 0);
+  CHECK(da.work_fluid == db.work_fluid);
+  CHECK(da.mass_defect == db.mass_defect);
+  CHECK(da.through_flow == db.through_flow);
 }

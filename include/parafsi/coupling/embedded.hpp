@@ -285,7 +285,35 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   /// The membrane flux of one patched face at one RK stage (fluid::face_patcher); the
   /// cell states are the stage's, read through the fluid's view.
   void patch(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo, fluid::cons<double>& hi) {
-    face_flux(fc, v, lo, hi);
+    record_patch(fc, lo, hi, solve_patch(fc, v, lo, hi));
+  }
+  /// The two halves of patch() (fluid::recording_face_patcher), so that a mesh split over
+  /// processes solves each face on one process and records it on all in list order:
+  /// solve_patch (const) sets the membrane fluxes and returns the through-velocity u_p;
+  /// record_patch adds the face's impulse, work, mass defect and through-flow (it reads
+  /// fc.patch, fc.stage and fc.area).
+  double solve_patch(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
+                     fluid::cons<double>& hi) const {
+    return face_flux(fc, v, lo, hi);
+  }
+  void record_patch(const fluid::face_context& fc, const fluid::cons<double>& lo, const fluid::cons<double>& hi,
+                    double up) {
+    const std::size_t fi = fc.patch;
+    const int stage = fc.stage;
+    require(fi < faces_.size() && stage >= 0 && stage < int(beta_.size()), "coupling::embedded: face ", fi,
+            " at stage ", stage, " is not one of this step's patches");
+    const face_rec& fr = faces_[fi];
+    const Eigen::Vector3d mL(lo.m.x, lo.m.y, lo.m.z), mR(hi.m.x, hi.m.y, hi.m.z);
+    const double wdt = beta_[std::size_t(stage)] * dt_f_ * fc.area;
+    face_J_[fi] += wdt * (mL - mR);
+    diag_.work_fluid += wdt * (lo.E - hi.E);
+    diag_.mass_defect += wdt * (lo.rho - hi.rho);
+    diag_.max_through_velocity = std::max(diag_.max_through_velocity, std::fabs(up));
+    if (stage + 1 == int(beta_.size()))
+      for (int q = 0; q < fr.n; ++q) {
+        const auto& cr = crossings_[std::size_t(fr.first + q)];
+        diag_.through_flow[std::size_t(cr.elem)] += up * fc.area / double(fr.n) * cr.sign;
+      }
   }
 
   /// No coupling springs; with the impedance term, its explicit substep limit
@@ -674,9 +702,9 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   }
 
  private:
-  /// The membrane flux of patched face fc.patch at stage fc.stage.
-  void face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
-                 fluid::cons<double>& hi) {
+  /// The membrane flux of patched face fc.patch at stage fc.stage; returns u_p.
+  double face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
+                   fluid::cons<double>& hi) const {
     const std::size_t fi = fc.patch;
     const int stage = fc.stage;
     require(fi < faces_.size() && stage >= 0 && stage < int(beta_.size()), "coupling::embedded: face ", fi,
@@ -731,16 +759,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     }
     lo = {fL, {mL.x(), mL.y(), mL.z()}, eL};
     hi = {fR, {mR.x(), mR.y(), mR.z()}, eR};
-    const double wdt = beta_[std::size_t(stage)] * dt_f_ * fc.area;
-    face_J_[fi] += wdt * (mL - mR);
-    diag_.work_fluid += wdt * (eL - eR);
-    diag_.mass_defect += wdt * (fL - fR);
-    diag_.max_through_velocity = std::max(diag_.max_through_velocity, std::fabs(s.up));
-    if (stage + 1 == int(beta_.size()))
-      for (int q = 0; q < fr.n; ++q) {
-        const auto& cr = crossings_[std::size_t(fr.first + q)];
-        diag_.through_flow[std::size_t(cr.elem)] += s.up * fc.area / double(fr.n) * cr.sign;
-      }
+    return s.up;
   }
 
   std::vector<detail::triangle> tris_;

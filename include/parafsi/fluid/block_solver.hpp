@@ -31,7 +31,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -360,10 +362,12 @@ class block_solver {
   /// blocks are stale between `gather()` calls: call it before reading cells this process
   /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
   /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
-  /// A coupling reads and writes cells near the replicated structure. Patched faces
-  /// (coupling::embedded) are processed by every process in list order, each stage after the
-  /// cells they read came from the processes computing them (share_slots), so the structure
-  /// gets the same loads everywhere and every cell its corrections in the same order. A
+  /// A coupling reads and writes cells near the replicated structure. Each stage the cells
+  /// the patched faces read come from the processes computing them (share_slots); a
+  /// recording patcher's faces (coupling::embedded) are then solved each by the process
+  /// computing its high cell and replayed by every process in list order (another patcher's
+  /// are processed by every process), so the structure gets the same loads everywhere and
+  /// every cell its corrections in the same order. A
   /// coupling that reads the air elsewhere (coupling::penalty's points) needs the blocks it
   /// touches computed by every process (mpi::block_halo's replicate_finest) and stops with a
   /// message otherwise. With an eddy-viscosity closure the wall distance is the caller's, on
@@ -894,20 +898,23 @@ class block_solver {
                                                                                                           keep);
   }
 
-  /// The coupling's patched faces, serially in list order (detail/patch_faces.hpp): each
-  /// face's regular flux is recomputed on the high cell's block, whose ghost layer holds the
-  /// low cell (a same-level copy), and the two cells' rates are corrected,
-  /// dU_low += (F − F_lo)/Δx, dU_high −= (F − F_hi)/Δx. Both cells must be leaf cells of one
-  /// level inside the box. With a one-sided patcher the membrane sees the cells' one-sided
-  /// values and the unblocked neighbouring faces are recomputed with them, each cell on its
-  /// own block (its stencil of two cells on the open side lies in that block's ghost layer),
-  /// as on the box: the same values and corrections, to round-off, on one level.
+  /// The coupling's patched faces (detail/patch_faces.hpp): each face's regular flux is
+  /// recomputed on the high cell's block, whose ghost layer holds the low cell (a same-level
+  /// copy), and the two cells' rates are corrected, dU_low += (F − F_lo)/Δx,
+  /// dU_high −= (F − F_hi)/Δx. Both cells must be leaf cells of one level inside the box.
+  /// With a one-sided patcher the membrane sees the cells' one-sided values and the
+  /// unblocked neighbouring faces are recomputed with them, each cell on its own block (its
+  /// stencil of two cells on the open side lies in that block's ghost layer), as on the box:
+  /// the same values and corrections, to round-off, on one level.
+  /// A recording patcher (patch.hpp) has its faces solved first, each on the process
+  /// computing its high cell, into one record per face (the fluxes, the patcher's value and
+  /// the rate changes), which every process then receives and replays in list order: the
+  /// patcher's sums, and the rates of the cells it computes. Any other patcher is called
+  /// face by face in list order by every process. Both give the bits of one process.
   template <class Patcher>
   void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
     constexpr bool one_sided = detail::wants_one_sided<Patcher>() && Recon::second_order;
     const std::span<const patch_face> faces = patcher.patch_faces();
-    const fluid::view state = view();
-    const auto dU = detail::conserved_ptrs(*dU_);
     for (std::size_t pi = 0; pi < faces.size(); ++pi) {
       const index_t c = faces[pi].high;
       const int d = faces[pi].axis;
@@ -921,9 +928,8 @@ class block_solver {
               ") is not between two leaf cells of one level inside the box: the membrane must lie on one level "
               "(refine around it)");
     }
-    // Distributed: every process processes every face (the replicated structure gets the same
-    // loads everywhere, each cell its corrections in list order), so the cells the faces read
-    // come to every process from the processes computing them first.
+    // Distributed: the cells the faces read come first from the processes computing them
+    // (to every process: each solves the faces of its cells, or every face).
     if (halo_) {
       patch_zone<one_sided>(faces, zone_);
       share_slots(zone_, true);
@@ -936,28 +942,24 @@ class block_solver {
         blocked_[std::size_t(neighbour(f.high, f.axis, 0))] |= std::uint8_t(1u << (2 * f.axis + 1));
       }
     }
-    for (std::size_t pi = 0; pi < faces.size(); ++pi) {
-      const index_t c = faces[pi].high;
-      const int d = faces[pi].axis;
-      const index_t id = c / stride_, lc = c % stride_;
-      const block& b = blocks_[std::size_t(id)];
-      const index_t ic = b.grid.ijk(lc)[std::size_t(d)];
-      const index_t m = neighbour(c, d, 0);
-      // The low cell lies in this block's ghost layer when ic = 0.
-      const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid,
-                                                detail::primitive_ptrs(std::as_const(b.W))};
-      face_context fc;
-      fc.low = m;
-      fc.high = c;
-      fc.stage = stage;
-      fc.patch = pi;
-      const cons<double> F = detail::regular_face(fk, geo, d, lc, fc);
-      if constexpr (one_sided)
-        detail::with_axis(d, [&](auto D) { one_sided_patch<decltype(D)::value>(geo, c, fc, dU); });
-      cons<double> Flo = F, Fhi = F;
-      patcher.patch(fc, state, Flo, Fhi);
-      detail::apply_face_patch(F, Flo, Fhi, m, b.grid.inv_widths(d)[ic - 1], true, c, b.grid.inv_widths(d)[ic], true,
-                               dU);
+    const fluid::view state = view();
+    const auto dU = detail::conserved_ptrs(*dU_);
+    if constexpr (recording_face_patcher<Patcher>) {
+      solve_faces<one_sided>(geo, stage, patcher, faces, state);
+      replay_faces(stage, patcher, faces.size(), dU);
+    } else {
+      for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+        face_context fc;
+        cons<double> F, Flo, Fhi;
+        face_record_ix ix;
+        regular_patch<one_sided>(geo, stage, faces, pi, fc, F, ix, [&](const double* dF, const face_change_at& at) {
+          detail::shift_face_change(dF, at.ga, at.ixa, at.a_in, at.gb, at.ixb, at.b_in, dU);
+        });
+        Flo = F;
+        Fhi = F;
+        patcher.patch(fc, state, Flo, Fhi);
+        detail::apply_face_patch(F, Flo, Fhi, fc.low, ix.low, true, fc.high, ix.high, true, dU);
+      }
     }
     if constexpr (one_sided)
       for (const patch_face& f : faces) {
@@ -966,20 +968,173 @@ class block_solver {
       }
   }
 
+  /// Where a neighbouring face's flux change goes (detail::shift_face_change's arguments).
+  struct face_change_at {
+    index_t ga, gb;
+    double ixa, ixb;
+    bool a_in, b_in;
+  };
+  /// The inverse widths of a patched face's two cells along its axis.
+  struct face_record_ix {
+    double low = 0, high = 0;
+  };
+  /// One patched face up to the patcher: its context (cells, stage, index, geometry and face
+  /// states) into fc, its regular flux into F, its cells' inverse widths into ix, and, one-
+  /// sided, the flux changes of the unblocked neighbouring faces through
+  /// change(dF[5], where), in the order they are applied.
+  template <bool OneSided, class Change>
+  void regular_patch(const detail::stage_geometry& geo, int stage, std::span<const patch_face> faces, std::size_t pi,
+                     face_context& fc, cons<double>& F, face_record_ix& ix, Change&& change) const {
+    const index_t c = faces[pi].high;
+    const int d = faces[pi].axis;
+    const index_t id = c / stride_, lc = c % stride_;
+    const block& b = blocks_[std::size_t(id)];
+    const index_t ic = b.grid.ijk(lc)[std::size_t(d)];
+    // The low cell lies in this block's ghost layer when ic = 0.
+    const detail::face_kernel<Flux, Recon> fk{flux_, recon_, gas_, b.grid, detail::primitive_ptrs(std::as_const(b.W))};
+    fc.low = neighbour(c, d, 0);
+    fc.high = c;
+    fc.stage = stage;
+    fc.patch = pi;
+    F = detail::regular_face(fk, geo, d, lc, fc);
+    if constexpr (OneSided)
+      detail::with_axis(d, [&](auto D) { one_sided_patch<decltype(D)::value>(geo, c, fc, change); });
+    ix.low = b.grid.inv_widths(d)[ic - 1];
+    ix.high = b.grid.inv_widths(d)[ic];
+  }
+
+  /// A solved face, as every process replays it (doubles; cell indices are exact):
+  /// area, F, F_lo, F_hi, the patcher's value, the two cells and inverse widths, and up to
+  /// two neighbouring-face changes (present, dF, ga, ixa, a_in, gb, ixb, b_in).
+  struct face_record {
+    static constexpr int area = 0, F = 1, lo = 6, hi = 11, value = 16, low = 17, ix_low = 18, high = 19, ix_high = 20,
+                         changes = 21, change_width = 12, width = changes + 2 * change_width;
+  };
+
+  /// Solve the faces whose high cell this process computes (all of them without a halo)
+  /// into face records, then bring the others' records from the processes solving them.
+  template <bool OneSided, class Patcher>
+  void solve_faces(const detail::stage_geometry& geo, int stage, const Patcher& patcher,
+                   std::span<const patch_face> faces, const fluid::view& state) {
+    constexpr int W = face_record::width;
+    records_.assign(faces.size() * std::size_t(W), 0.0);
+    record_block_.resize(faces.size());
+    mine_.clear();
+    for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+      record_block_[pi] = faces[pi].high / stride_;
+      if (computes_[std::size_t(record_block_[pi])]) mine_.push_back(index_t(pi));
+    }
+    // The faces are independent (each writes its own record), so threads may share them; a
+    // face that fails is reported after the loop, the first in list order.
+    std::mutex failing;
+    std::size_t failed_at = faces.size();
+    std::exception_ptr failure;
+    detail::par_for(threaded_ && mine_.size() >= 64, 0, index_t(mine_.size()), [&](index_t m) {
+      const std::size_t pi = std::size_t(mine_[std::size_t(m)]);
+      try {
+        solve_face<OneSided>(geo, stage, patcher, faces, pi, state, records_.data() + pi * std::size_t(W));
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failing);
+        if (pi < failed_at) {
+          failed_at = pi;
+          failure = std::current_exception();
+        }
+      }
+    });
+    if (failure) std::rethrow_exception(failure);
+    if (halo_) halo_->gather_items(record_block_, records_, W);
+  }
+
+  /// Face pi solved into its record r.
+  template <bool OneSided, class Patcher>
+  void solve_face(const detail::stage_geometry& geo, int stage, const Patcher& patcher,
+                  std::span<const patch_face> faces, std::size_t pi, const fluid::view& state, double* r) const {
+    face_context fc;
+    cons<double> F;
+    face_record_ix ix;
+    int k = 0;
+    regular_patch<OneSided>(geo, stage, faces, pi, fc, F, ix, [&](const double* dF, const face_change_at& at) {
+      double* c = r + face_record::changes + k++ * face_record::change_width;
+      c[0] = 1.0;
+      for (int q = 0; q < 5; ++q) c[1 + q] = dF[q];
+      c[6] = double(at.ga);
+      c[7] = at.ixa;
+      c[8] = at.a_in ? 1.0 : 0.0;
+      c[9] = double(at.gb);
+      c[10] = at.ixb;
+      c[11] = at.b_in ? 1.0 : 0.0;
+    });
+    cons<double> Flo = F, Fhi = F;
+    r[face_record::value] = patcher.solve_patch(fc, state, Flo, Fhi);
+    r[face_record::area] = fc.area;
+    put(r + face_record::F, F);
+    put(r + face_record::lo, Flo);
+    put(r + face_record::hi, Fhi);
+    r[face_record::low] = double(fc.low);
+    r[face_record::ix_low] = ix.low;
+    r[face_record::high] = double(fc.high);
+    r[face_record::ix_high] = ix.high;
+  }
+
+  /// Every face's record in list order: the neighbouring-face changes, the patcher's sums,
+  /// the face's own correction; rates only of the cells this process computes.
+  template <class Patcher>
+  void replay_faces(int stage, Patcher& patcher, std::size_t count, const detail::fields5<double>& dU) {
+    constexpr int W = face_record::width;
+    auto here = [&](index_t g) { return g >= 0 && computes_[std::size_t(g / stride_)] != 0; };
+    for (std::size_t pi = 0; pi < count; ++pi) {
+      const double* r = records_.data() + pi * std::size_t(W);
+      for (int k = 0; k < 2; ++k) {
+        const double* c = r + face_record::changes + k * face_record::change_width;
+        if (c[0] == 0.0) continue;
+        const index_t ga = index_t(c[6]), gb = index_t(c[9]);
+        detail::shift_face_change(c + 1, ga, c[7], c[8] != 0.0 && here(ga), gb, c[10], c[11] != 0.0 && here(gb), dU);
+      }
+      face_context fc;
+      fc.stage = stage;
+      fc.patch = pi;
+      fc.area = r[face_record::area];
+      fc.low = index_t(r[face_record::low]);
+      fc.high = index_t(r[face_record::high]);
+      const cons<double> F = get(r + face_record::F), Flo = get(r + face_record::lo), Fhi = get(r + face_record::hi);
+      patcher.record_patch(fc, Flo, Fhi, r[face_record::value]);
+      detail::apply_face_patch(F, Flo, Fhi, fc.low, r[face_record::ix_low], here(fc.low), fc.high,
+                               r[face_record::ix_high], here(fc.high), dU);
+    }
+  }
+  static void put(double* o, const cons<double>& u) noexcept {
+    o[0] = u.rho;
+    o[1] = u.m.x;
+    o[2] = u.m.y;
+    o[3] = u.m.z;
+    o[4] = u.E;
+  }
+  static cons<double> get(const double* o) noexcept { return {o[0], {o[1], o[2], o[3]}, o[4]}; }
+
   /// The storage slots (block · stride + local, ghosts included) the processing of the
   /// patched faces reads: along each face's axis, the high cell and, one-sided, the low cell
   /// and the cells below and above them (as step_ref walks them), each with the two slots
   /// either side of it in its block's grid (the kernels' stencils), clipped to the grid;
-  /// else the high cell's slots and the low cell (the patcher's view). Sorted, unique.
+  /// else the high cell's slots and the low cell (the patcher's view). Each once, in the
+  /// order first met.
   template <bool OneSided>
-  void patch_zone(std::span<const patch_face> faces, std::vector<index_t>& zone) const {
+  void patch_zone(std::span<const patch_face> faces, std::vector<index_t>& zone) {
     zone.clear();
     constexpr index_t ng = rectilinear_grid::ghosts;
+    // Each slot once, in the order first met (the same on every process): a mark per slot
+    // instead of a sort, which cost 3 % of a large drop's step.
+    if (zone_mark_.size() != std::size_t(stride_ * block_count()))
+      zone_mark_.assign(std::size_t(stride_ * block_count()), 0);
+    auto add = [&](index_t g) {
+      if (zone_mark_[std::size_t(g)]) return;
+      zone_mark_[std::size_t(g)] = 1;
+      zone.push_back(g);
+    };
     auto around = [&](index_t id, index_t local, int d) {
       const rectilinear_grid& g = blocks_[std::size_t(id)].grid;
       const index_t ia = g.ijk(local)[std::size_t(d)], st = g.stride(d);
       for (index_t k = -2; k <= 2; ++k)
-        if (ia + k >= -ng && ia + k < n_ + ng) zone.push_back(id * stride_ + local + k * st);
+        if (ia + k >= -ng && ia + k < n_ + ng) add(id * stride_ + local + k * st);
     };
     for (const patch_face& f : faces) {
       const index_t c = f.high;
@@ -991,11 +1146,10 @@ class block_solver {
         const cell_ref lc = step_ref(hc, d, 0), below = step_ref(lc, d, 0), above = step_ref(hc, d, 1);
         for (const cell_ref& r : {lc, below, above}) around(r.id, r.local, d);
       } else {
-        zone.push_back(neighbour(c, d, 0));
+        add(neighbour(c, d, 0));
       }
     }
-    std::sort(zone.begin(), zone.end());
-    zone.erase(std::unique(zone.begin(), zone.end()), zone.end());
+    for (index_t g : zone) zone_mark_[std::size_t(g)] = 0;
   }
 
   /// The conserved state (and with `primitives` the stage's primitives) at storage slots
@@ -1078,11 +1232,10 @@ class block_solver {
     return {flux_, recon_, gas_, b.grid, detail::primitive_ptrs(std::as_const(b.W))};
   }
   /// The one-sided part of the patch of the face below cell c along D (detail/patch_faces.hpp):
-  /// the membrane's face states (fc.L, fc.R) and the corrections of the unblocked
-  /// neighbouring faces, each once.
-  template <int D>
-  void one_sided_patch(const detail::stage_geometry& geo, index_t c, face_context& fc,
-                       const detail::fields5<double>& dU) const {
+  /// the membrane's face states (fc.L, fc.R), and the flux changes of the unblocked
+  /// neighbouring faces, each once, through change(dF[5], where).
+  template <int D, class Change>
+  void one_sided_patch(const detail::stage_geometry& geo, index_t c, face_context& fc, Change& change) const {
     using side = detail::face_side<Flux, Recon>;
     const cell_ref hc{c / stride_, c % stride_, blocks_[std::size_t(c / stride_)].grid.ijk(c % stride_)[std::size_t(D)],
                       c};
@@ -1094,13 +1247,17 @@ class block_solver {
     fc.L = detail::prim_of(h1);
     detail::one_sided_cell_faces<D>(fk_h, H.bf, H.cell, H.ia, l1, h1);
     fc.R = detail::prim_of(l1);
+    auto move = [&](const cons<double>& dF, const side& a, index_t ga, const side& b, index_t gb) {
+      const double d[5] = {dF.rho, dF.m.x, dF.m.y, dF.m.z, dF.E};
+      const auto [ixa, ixb] = detail::face_change_widths<D>(a, b);
+      change(d, face_change_at{ga, gb, ixa, ixb, a.in, b.in});
+    };
     if (!L.bf.lo) {
       const side B{&fk_b, below.local, below.ia, blocked_of<D>(below), below.global >= 0};
-      detail::move_face_change<D>(detail::neighbour_face_change<D>(geo, B, L), B, below.global, L, lc.global, dU);
+      move(detail::neighbour_face_change<D>(geo, B, L), B, below.global, L, lc.global);
     }
     const side A{&fk_a, above.local, above.ia, blocked_of<D>(above), above.global >= 0};
-    if (!H.bf.hi && !A.bf.hi)
-      detail::move_face_change<D>(detail::neighbour_face_change<D>(geo, H, A), H, hc.global, A, above.global, dU);
+    if (!H.bf.hi && !A.bf.hi) move(detail::neighbour_face_change<D>(geo, H, A), H, hc.global, A, above.global);
   }
 
   /// Every block's face ghosts from neighbours, then the box's boundary conditions; edge
@@ -1304,6 +1461,10 @@ class block_solver {
   std::unique_ptr<turbulence_storage> T_;                 ///< with an eddy-viscosity closure
   std::vector<std::uint8_t> blocked_;                     ///< membrane faces' marks (one-sided patches; global_index)
   std::vector<index_t> zone_, share_block_, share_slot_;  ///< patch_zone, share_slots scratch
+  std::vector<double> records_;                           ///< solve_faces: face_record::width per face
+  std::vector<index_t> record_block_;                     ///< solve_faces: the block of each face's high cell
+  std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves
+  std::vector<std::uint8_t> zone_mark_;                   ///< patch_zone: slots already listed (all 0 between calls)
   std::vector<double> share_vals_;
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;

@@ -9,10 +9,19 @@
 ///                                      receives (they may differ: a membrane in the face
 ///                                      takes the difference as its load).
 /// The solver computes the regular flux first and corrects the two cells' rates, per RK
-/// stage, serially in list order; the context names the stage and the patch index.
-/// On a block mesh split over processes (block_solver::set_halo) every process calls
-/// patch() for every face, and the view is current only at each face's two cells (fc.low,
-/// fc.high): a patcher must read nothing else of the air.
+/// stage, in list order; the context names the stage and the patch index.
+/// A patcher may split patch() into a pure half and a recording half
+/// (recording_face_patcher):
+///   p.solve_patch(fc, view, lo, hi) → double  (const: the fluxes, and one number for ...)
+///   p.record_patch(fc, lo, hi, value)         (... the patcher's own sums; reads fc.patch,
+///                                              fc.stage and fc.area only)
+/// with patch() = record_patch(solve_patch()). The block mesh then solves the faces in
+/// parallel (threads, and on a mesh split over processes each face on the process computing
+/// its high cell) and records them, and corrects the cells' rates, in list order on every
+/// process: the same bits as patch() face by face. A patcher without the split is called
+/// face by face in list order by every process. Either way, on a mesh split over processes
+/// the view is current only at each face's two cells (fc.low, fc.high): a patcher must read
+/// nothing else of the air.
 #pragma once
 #include <concepts>
 #include <span>
@@ -51,6 +60,14 @@ template <class P>
 concept face_patcher = requires(P& p, const P& cp, const face_context& fc, const view& v, cons<double>& q) {
   { cp.patch_faces() } -> std::convertible_to<std::span<const patch_face>>;
   p.patch(fc, v, q, q);
+};
+
+/// A face patcher whose patch() is split into solve_patch (const) and record_patch.
+template <class P>
+concept recording_face_patcher = face_patcher<P> &&
+    requires(P& p, const P& cp, const face_context& fc, const view& v, cons<double>& q) {
+  { cp.solve_patch(fc, v, q, q) } -> std::convertible_to<double>;
+  p.record_patch(fc, std::as_const(q), std::as_const(q), 0.0);
 };
 
 /// No patched faces.

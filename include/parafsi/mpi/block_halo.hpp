@@ -20,9 +20,9 @@
 /// registers other ranks read are swept (begin_registers) and travel while the solver sweeps the remaining blocks and
 /// corrects the coarse blocks whose corrections read only this rank's registers (end_registers waits). The reductions
 /// are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. A
-/// coupling's cells (gather_items: the cells the embedded coupling's faces read, each stage) travel by one
-/// MPI_Allgatherv, each from the process computing its block, so every process holds them and processes every face
-/// alike. Results are therefore bitwise those of one process.
+/// coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of the faces each
+/// process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so every process
+/// replays every face alike. Results are therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
 /// block's arrays), and a gather-free regrid.

@@ -14,8 +14,9 @@
 ///   - the face-register entries of finer blocks that its coarse blocks' flux corrections
 ///     read (blocks/flux_correction.hpp): `correction_reads`;
 ///   - the cells a coupling's patched faces read (fluid::block_solver's share_slots: the
-///     stage's state and primitives around every face), gathered to every process so that
-///     each processes every face alike and the replicated structure gets the same loads;
+///     stage's state and primitives around every face), and the records of the faces each
+///     process solved (solve_faces), gathered to every process so that each replays every
+///     face alike and the replicated structure gets the same loads;
 ///   - reductions: the stable step (a maximum, exact) and sums over the mesh, which are
 ///     formed per block and added in block order on every process, so that they do not
 ///     depend on the number of processes.

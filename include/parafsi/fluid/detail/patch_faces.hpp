@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <span>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "../../core/error.hpp"
@@ -160,15 +161,28 @@ cons<double> neighbour_face_change(const stage_geometry& geo, const face_side<Fl
 
 /// Move a face's flux change dF between its cells' rates (global indices of dU; a side
 /// that is not `in` is left alone): dU_a −= dF/Δx_a, dU_b += dF/Δx_b.
+/// A face's flux change between two cells' rates: dU_a −= d/Δx_a (if a_in), dU_b += d/Δx_b
+/// (if b_in); a recorded change (block_solver's face records) is replayed by the same code.
+inline void shift_face_change(const double* d, index_t ga, double ixa, bool a_in, index_t gb, double ixb, bool b_in,
+                              const fields5<double>& dU) {
+  for (int q = 0; q < 5; ++q) {
+    if (a_in) dU[q][ga] -= d[q] * ixa;
+    if (b_in) dU[q][gb] += d[q] * ixb;
+  }
+}
+
+/// The inverse widths of a face change's two cells along D (0 for a side that is not `in`).
+template <int D, class Flux, class Recon>
+std::pair<double, double> face_change_widths(const face_side<Flux, Recon>& a, const face_side<Flux, Recon>& b) {
+  return {a.in ? a.fk->grid.inv_widths(D)[a.ia] : 0.0, b.in ? b.fk->grid.inv_widths(D)[b.ia] : 0.0};
+}
+
 template <int D, class Flux, class Recon>
 void move_face_change(const cons<double>& dF, const face_side<Flux, Recon>& a, index_t ga,
                       const face_side<Flux, Recon>& b, index_t gb, const fields5<double>& dU) {
   const double d[5] = {dF.rho, dF.m.x, dF.m.y, dF.m.z, dF.E};
-  const double ixa = a.in ? a.fk->grid.inv_widths(D)[a.ia] : 0.0, ixb = b.in ? b.fk->grid.inv_widths(D)[b.ia] : 0.0;
-  for (int q = 0; q < 5; ++q) {
-    if (a.in) dU[q][ga] -= d[q] * ixa;
-    if (b.in) dU[q][gb] += d[q] * ixb;
-  }
+  const auto [ixa, ixb] = face_change_widths<D>(a, b);
+  shift_face_change(d, ga, ixa, a.in, gb, ixb, b.in, dU);
 }
 
 /// Recompute the unblocked face between cells a (low, index ia along D) and a + s of the

@@ -102,7 +102,7 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
     // read remote cells, registers stay), and corrections that wait for them.
     long kinds[3] = {0, 0, 0};
     for (index_t id : dist->computed_blocks()) {
-      kinds[0] += halo->sends_registers(id);
+      kinds[0] += halo->reads_remote(id) && halo->sends_registers(id);
       kinds[1] += halo->reads_remote(id) && !halo->sends_registers(id);
       kinds[2] += halo->corrects_remote(id);
     }
@@ -355,3 +355,61 @@ TEST_CASE("distributed block mesh: a solver moved after set_halo attaches again 
 }
 
 int main(int argc, char** argv) { return mpt::run_tests(argc, argv); }
+
+namespace {
+/// A recording face patcher that passes the regular flux through and fails on face `bad`.
+struct failing_patcher {
+  std::vector<fluid::patch_face> faces;
+  std::size_t bad = 0;
+  std::span<const fluid::patch_face> patch_faces() const noexcept { return faces; }
+  double solve_patch(const fluid::face_context& fc, const fluid::view&, fluid::cons<double>&,
+                     fluid::cons<double>&) const {
+    if (fc.patch == bad) throw pf::numerical_failure("test face failed on purpose", long(fc.patch), 0.0);
+    return 0.0;
+  }
+  void record_patch(const fluid::face_context&, const fluid::cons<double>&, const fluid::cons<double>&, double) {}
+  void patch(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo, fluid::cons<double>& hi) {
+    record_patch(fc, lo, hi, solve_patch(fc, v, lo, hi));
+  }
+};
+}  // namespace
+
+TEST_CASE("a patched face that fails stops every process, the first failing face in list order") {
+  // Faces are solved by the process computing their high cell; a failure there must reach
+  // the others through the gathered records, not leave them waiting in a collective call.
+  static_assert(fluid::recording_face_patcher<failing_patcher>);
+  const int P = world_size();
+  fluid::block_layout lay{{0, 0, 0}, {1, 1, 0.25}, {4, 4, 1}, 8};
+  fb::tree t({4, 4, 1}, {true, true, true});
+  auto make = [&] {
+    auto s = std::make_unique<fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::mc>>>(
+        t, lay, pf::boundary::set::all(pf::boundary::periodic{}));
+    s->fill_uniform({1.2, {3, 0, 0}, 1e5});
+    return s;
+  };
+  auto dist = make();
+  dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  // One face (axis x, an interior cell) in every block; the failing one in the last block,
+  // which the last process computes.
+  failing_patcher p;
+  const fb::block_index at{lay.block_cells};
+  for (index_t id = 0; id < dist->block_count(); ++id) p.faces.push_back({dist->global_index(id, at(3, 4, 4)), 0});
+  p.bad = p.faces.size() - 1;
+  const index_t bad_block = dist->block_count() - 1;
+  const auto& mine = dist->computed_blocks();
+  const bool solves_bad = std::find(mine.begin(), mine.end(), bad_block) != mine.end();
+  if (P > 1) CHECK(solves_bad == (world_rank() == P - 1));
+  std::string what;
+  try {
+    dist->step(dist->stable_dt(0.5), p);
+  } catch (const pf::numerical_failure& e) {
+    what = e.what();
+    CHECK(e.index == long(p.bad));
+  }
+  CHECK(!what.empty());  // every process stopped
+  if (solves_bad) CHECK(what.find("on purpose") != std::string::npos);
+  else CHECK(what.find("failed on the process solving it") != std::string::npos);
+  // The processes are still in step: a collective call completes.
+  long one = 1;
+  CHECK(sum_over_processes(one) == P);
+}

@@ -6,8 +6,9 @@
 //     coupling and the embedded coupling's one-sided faces;
 //   - with every level split over the processes: the embedded coupling (first-order and
 //     one-sided faces, impermeable and porous, with the impedance term), whose faces' cells
-//     come to every process each stage (block_solver::share_slots), so every process
-//     processes every face and the replicated structure gets the same loads everywhere;
+//     come to every process each stage (block_solver::share_slots); each face is solved
+//     by the process computing its high cell and its record replayed by every process in
+//     list order, so the replicated structure gets the same loads everywhere;
 //   - the penalty coupling on a split finest level stops with a message on every process.
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>

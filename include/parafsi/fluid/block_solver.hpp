@@ -725,8 +725,9 @@ class block_solver {
     attach_halo();
   }
 
-  /// The blocks this process computes, from the halo (all without one), split into those
-  /// whose ghosts are all local and those that read another process's cells.
+  /// The blocks this process computes, from the halo (all without one), listed by what they
+  /// wait for in a stage: their ghosts (local, or remote and sending registers, or remote)
+  /// and their corrections (local or remote registers).
   void attach_halo() {
     computed_.clear();
     attached_to_ = this;
@@ -1024,24 +1025,27 @@ class block_solver {
       record_block_[pi] = faces[pi].high / stride_;
       if (computes_[std::size_t(record_block_[pi])]) mine_.push_back(index_t(pi));
     }
-    // The faces are independent (each writes its own record), so threads may share them; a
-    // face that fails is reported after the loop, the first in list order.
+    // The faces are independent (each writes its own record), so threads may share them. A
+    // face that fails marks its record (area −1) and keeps its error, so that every process
+    // learns of it from the gathered records and stops at the first failing face in list
+    // order (replay_faces): no process is left waiting in a collective call.
     std::mutex failing;
-    std::size_t failed_at = faces.size();
-    std::exception_ptr failure;
+    failed_at_ = faces.size();
+    failure_ = nullptr;
     detail::par_for(threaded_ && mine_.size() >= 64, 0, index_t(mine_.size()), [&](index_t m) {
       const std::size_t pi = std::size_t(mine_[std::size_t(m)]);
+      double* r = records_.data() + pi * std::size_t(W);
       try {
-        solve_face<OneSided>(geo, stage, patcher, faces, pi, state, records_.data() + pi * std::size_t(W));
+        solve_face<OneSided>(geo, stage, patcher, faces, pi, state, r);
       } catch (...) {
+        r[face_record::area] = -1.0;
         const std::lock_guard<std::mutex> lock(failing);
-        if (pi < failed_at) {
-          failed_at = pi;
-          failure = std::current_exception();
+        if (pi < failed_at_) {
+          failed_at_ = pi;
+          failure_ = std::current_exception();
         }
       }
     });
-    if (failure) std::rethrow_exception(failure);
     if (halo_) halo_->gather_items(record_block_, records_, W);
   }
 
@@ -1084,6 +1088,12 @@ class block_solver {
     auto here = [&](index_t g) { return g >= 0 && computes_[std::size_t(g / stride_)] != 0; };
     for (std::size_t pi = 0; pi < count; ++pi) {
       const double* r = records_.data() + pi * std::size_t(W);
+      if (r[face_record::area] < 0.0) {  // the face's solver failed (solve_faces)
+        if (failure_ && failed_at_ == pi) std::rethrow_exception(failure_);
+        throw numerical_failure(parafsi::detail::concat("fluid::block_solver: patched face ", pi,
+                                                        " failed on the process solving it (its message is there)"),
+                                long(pi), t_);
+      }
       for (int k = 0; k < 2; ++k) {
         const double* c = r + face_record::changes + k * face_record::change_width;
         if (c[0] == 0.0) continue;
@@ -1136,6 +1146,19 @@ class block_solver {
       for (index_t k = -2; k <= 2; ++k)
         if (ia + k >= -ng && ia + k < n_ + ng) add(id * stride_ + local + k * st);
     };
+    auto unmark = [&] {
+      for (index_t g : zone) zone_mark_[std::size_t(g)] = 0;
+    };
+    try {
+      list_zone<OneSided>(faces, around, add);
+    } catch (...) {
+      unmark();  // a refused face (step_ref) leaves no marks behind
+      throw;
+    }
+    unmark();
+  }
+  template <bool OneSided, class Around, class Add>
+  void list_zone(std::span<const patch_face> faces, Around& around, Add& add) const {
     for (const patch_face& f : faces) {
       const index_t c = f.high;
       const int d = f.axis;
@@ -1149,7 +1172,6 @@ class block_solver {
         add(neighbour(c, d, 0));
       }
     }
-    for (index_t g : zone) zone_mark_[std::size_t(g)] = 0;
   }
 
   /// The conserved state (and with `primitives` the stage's primitives) at storage slots
@@ -1464,6 +1486,8 @@ class block_solver {
   std::vector<double> records_;                           ///< solve_faces: face_record::width per face
   std::vector<index_t> record_block_;                     ///< solve_faces: the block of each face's high cell
   std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves
+  std::size_t failed_at_ = 0;                             ///< solve_faces: the first face it failed to solve
+  std::exception_ptr failure_;                            ///< and that face's error
   std::vector<std::uint8_t> zone_mark_;                   ///< patch_zone: slots already listed (all 0 between calls)
   std::vector<double> share_vals_;
   std::vector<blocks::block_plan> plan_;

@@ -17,8 +17,8 @@
 ///                                              fc.stage and fc.area only)
 /// with patch() = record_patch(solve_patch()). The block mesh then solves the faces in
 /// parallel (threads, and on a mesh split over processes each face on the process computing
-/// its high cell) and records them, and corrects the cells' rates, in list order on every
-/// process: the same bits as patch() face by face. A patcher without the split is called
+/// its high cell, or on all where all compute it) and records them, and corrects the cells'
+/// rates, in list order on every process: the same bits as patch() face by face. A patcher without the split is called
 /// face by face in list order by every process. Either way, on a mesh split over processes
 /// the view is current only at each face's two cells (fc.low, fc.high): a patcher must read
 /// nothing else of the air.

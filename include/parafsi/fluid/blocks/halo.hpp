@@ -191,7 +191,7 @@ struct halo_counters {
   std::int64_t messages = 0;        ///< point-to-point messages sent
   std::int64_t bytes = 0;           ///< bytes in them
   std::int64_t exchanges = 0;       ///< state exchanges (one per stage)
-  std::int64_t gathers = 0;         ///< item gathers (gather_items: a coupling's cells, per stage)
+  std::int64_t gathers = 0;         ///< item gathers (gather_items: a coupling's cells and face records, per stage)
   std::int64_t gathered_bytes = 0;  ///< bytes they assembled on every process
 };
 

@@ -159,8 +159,6 @@ cons<double> neighbour_face_change(const stage_geometry& geo, const face_side<Fl
   return {F1.rho - F0.rho, {F1.m.x - F0.m.x, F1.m.y - F0.m.y, F1.m.z - F0.m.z}, F1.E - F0.E};
 }
 
-/// Move a face's flux change dF between its cells' rates (global indices of dU; a side
-/// that is not `in` is left alone): dU_a −= dF/Δx_a, dU_b += dF/Δx_b.
 /// A face's flux change between two cells' rates: dU_a −= d/Δx_a (if a_in), dU_b += d/Δx_b
 /// (if b_in); a recorded change (block_solver's face records) is replayed by the same code.
 inline void shift_face_change(const double* d, index_t ga, double ixa, bool a_in, index_t gb, double ixb, bool b_in,
@@ -177,6 +175,8 @@ std::pair<double, double> face_change_widths(const face_side<Flux, Recon>& a, co
   return {a.in ? a.fk->grid.inv_widths(D)[a.ia] : 0.0, b.in ? b.fk->grid.inv_widths(D)[b.ia] : 0.0};
 }
 
+/// Move a face's flux change dF between its cells' rates (global indices of dU; a side
+/// that is not `in` is left alone): dU_a −= dF/Δx_a, dU_b += dF/Δx_b.
 template <int D, class Flux, class Recon>
 void move_face_change(const cons<double>& dF, const face_side<Flux, Recon>& a, index_t ga,
                       const face_side<Flux, Recon>& b, index_t gb, const fields5<double>& dU) {

@@ -17,7 +17,7 @@
 /// along x (pointwise physics on V, scalar tail), each value with the operations of the
 /// scalar pass (Lanes = 1, kept as the reference) in the same order: the rotations reproduce
 /// Eigen's 3×3 product (rotate below), and the filter width Δ = (h_x h_y h_z)^{1/3} is
-/// std::cbrt lane by lane, reused while the cell widths repeat. Without contraction of
+/// std::cbrt lane by lane, memoised by the width product. Without contraction of
 /// a b + c (-ffp-contract=off) packs, scalars and the stored-gradient form agree bit for bit;
 /// with it (the default where the hardware has FMA) the compiler fuses some sums differently
 /// in each: round-off.
@@ -153,22 +153,28 @@ struct viscous_pass {
     const double* hx = grid.widths(0);
     if constexpr (has_eddy_viscosity)
       par_for(threaded, -1, nz + 1, [&](index_t k) {
-        // Δ of the last cell, reused while its widths repeat (the same product, the same cube
-        // root): along a row, and from row to row on a uniform grid such as a block.
-        double hx_last = std::numeric_limits<double>::quiet_NaN(), hy_last = hx_last, hz_last = hx_last;
-        double delta_last = 0.0;
+        // Δ from a memo of the last four width products met (an exact match gives the same
+        // cube root): the widths of a block or a uniform core, x_I = lo + (hi − lo) I/N, take
+        // a few values that differ in their last bits, which a last-value memo kept missing
+        // (the cube root was 3 % of a block drop's step).
+        constexpr int memo_size = 4;
+        double memo_p[memo_size], memo_d[memo_size];
+        std::fill(memo_p, memo_p + memo_size, std::numeric_limits<double>::quiet_NaN());
+        std::fill(memo_d, memo_d + memo_size, 0.0);
+        int memo_next = 0;
         for (index_t j = -1; j < ny + 1; ++j) {
           const index_t base = grid.index(0, j, k);
           const double inv_y = inv_gap(1, j), inv_z = inv_gap(2, k);
           const double hy = grid.width(1, j), hz = grid.width(2, k);
           auto delta_at = [&](index_t i) {
-            if (!(hx[i] == hx_last && hy == hy_last && hz == hz_last)) {
-              hx_last = hx[i];
-              hy_last = hy;
-              hz_last = hz;
-              delta_last = std::cbrt(hx[i] * hy * hz);
-            }
-            return delta_last;
+            const double p = hx[i] * hy * hz;
+            for (int q = 0; q < memo_size; ++q)
+              if (memo_p[q] == p) return memo_d[q];
+            const double d = std::cbrt(p);
+            memo_p[memo_next] = p;
+            memo_d[memo_next] = d;
+            memo_next = (memo_next + 1) % memo_size;
+            return d;
           };
           lanes(-1, nx + 1, [&](auto tag, index_t i) {
             using V = typename decltype(tag)::type;

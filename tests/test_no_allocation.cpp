@@ -3,7 +3,9 @@
 // warm-up steps (scratch buffers are sized then), and the next steps must allocate
 // nothing — exactly zero calls of operator new — for the coupled stepper with each
 // coupling, a fluid-only stepper (viscous + turbulent, far field with sponge, sources)
-// and a structure-only stepper. stable_dt() is counted too (it runs every step).
+// and a structure-only stepper, and for the embedded coupling (one-sided faces, solved into
+// records and replayed) on three levels of blocks. stable_dt() is counted too (it runs
+// every step).
 #include <doctest/doctest.h>
 
 #include <parafsi/coupling/coupling.hpp>
@@ -11,6 +13,8 @@
 #include <parafsi/fluid/fluid.hpp>
 #include <parafsi/model/rect_mesh.hpp>
 #include <parafsi/structure/structure.hpp>
+
+#include "coupling_test_util.hpp"
 
 #include <atomic>
 #include <cstdlib>
@@ -105,6 +109,13 @@ TEST_CASE("a coupled step with the embedded coupling allocates nothing after war
   pf::explicit_stepper s{box(), membrane(), pf::coupling::embedded{pf::porosity::impermeable{}}};
   CHECK(allocations_in_steps(s, 2, 4) == 0);
   CHECK(s.coupling().diagnostics().faces > 0);
+}
+
+TEST_CASE("a coupled step with the one-sided embedded coupling on three levels of blocks allocates nothing") {
+  auto s = ctu::blocks_patch(2, pf::coupling::embedded<pf::porosity::impermeable, true>{pf::porosity::impermeable{}});
+  CHECK(allocations_in_steps(s, 2, 4) == 0);
+  CHECK(s.coupling().diagnostics().faces > 0);
+  CHECK(s.fluid().tree().finest_level() == 2);
 }
 
 TEST_CASE("a fluid-only step (viscous, turbulent, sponge, sources, moving box) allocates nothing after warm-up") {

@@ -231,7 +231,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   template <class Fluid, class Asm>
   void exchange(Fluid& f, const Asm& s, double dt_f) {
     this->require_attached();
-    space_ = face_space::of(f);
+    space_.refresh(f);  // the index grid is rebuilt only when the mesh's finest extent changed
     const auto& nd = s.node_set();
     const frame::pose& pose = f.pose();
     dt_f_ = dt_f;

@@ -188,21 +188,33 @@ class face_space {
   template <class F>
   static face_space of(const F& f) {
     face_space s;
+    s.refresh(f);
+    return s;
+  }
+  /// Follow the fluid's mesh (every step: a regrid may have changed it); the index grid is
+  /// rebuilt only when the finest level's extent changed, so a step allocates nothing.
+  template <class F>
+  void refresh(const F& f) {
     if constexpr (block_fluid<F>) {
       const auto& lay = f.layout();
       const int L = f.tree().finest_level();
       std::array<index_t, 3> N{};
       for (int d = 0; d < 3; ++d) N[std::size_t(d)] = f.tree().extent(d, L) * lay.block_cells;
-      s.own_ = fluid::rectilinear_grid::uniform(N, lay.lo, lay.hi);
-      s.grid_ = &s.own_;
-      s.tree_ = &f.tree();
-      s.n_ = lay.block_cells;
-      s.stride_ = f.stride();
-      s.level_ = L;
+      if (grid_ != &own_ || N != N_ || lay.lo != lo_ || lay.hi != hi_) {
+        own_ = fluid::rectilinear_grid::uniform(N, lay.lo, lay.hi);
+        N_ = N;
+        lo_ = lay.lo;
+        hi_ = lay.hi;
+      }
+      grid_ = &own_;
+      tree_ = &f.tree();
+      n_ = lay.block_cells;
+      stride_ = f.stride();
+      level_ = L;
     } else {
-      s.grid_ = &f.grid();
+      grid_ = &f.grid();
+      tree_ = nullptr;
     }
-    return s;
   }
   face_space(const face_space& o) { *this = o; }
   face_space& operator=(const face_space& o) {
@@ -213,6 +225,9 @@ class face_space {
     n_ = o.n_;
     stride_ = o.stride_;
     level_ = o.level_;
+    N_ = o.N_;
+    lo_ = o.lo_;
+    hi_ = o.hi_;
     return *this;
   }
 
@@ -239,6 +254,8 @@ class face_space {
   const fluid::blocks::tree* tree_ = nullptr;
   index_t n_ = 0, stride_ = 0;
   int level_ = 0;
+  std::array<index_t, 3> N_{};         ///< own_'s cells per axis (refresh)
+  std::array<double, 3> lo_{}, hi_{};  ///< and its box
 };
 
 namespace detail {

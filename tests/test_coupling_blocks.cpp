@@ -202,7 +202,7 @@ TEST_CASE_TEMPLATE("embedded faces solved apart and replayed in list order: the 
   const auto& da = rec.coupling().diagnostics();
   const auto& db = one.coupling().diagnostics();
   MESSAGE(da.faces, " faces, ", cells, " cells, nodes moved by up to ", moved, " m/s; values differing: ", differ);
-  CHECK(da.faces >= 64);  // enough for the threaded solve (block_solver::solve_faces)
+  CHECK(da.faces >= 64);  // block_solver::threaded_faces: the threaded solve runs
   CHECK(cells > 0);
   CHECK(moved > 1e-3);  // the coupling acted
   CHECK(differ == 0);

@@ -1004,6 +1004,8 @@ class block_solver {
     ix.high = b.grid.inv_widths(d)[ic];
   }
 
+  /// Faces solved on threads from this many on (below, waking threads costs more).
+  static constexpr std::size_t threaded_faces = 64;
   /// A solved face, as every process replays it (doubles; cell indices are exact):
   /// area, F, F_lo, F_hi, the patcher's value, the two cells and inverse widths, and up to
   /// two neighbouring-face changes (present, dF, ga, ixa, a_in, gb, ixb, b_in).
@@ -1032,7 +1034,7 @@ class block_solver {
     std::mutex failing;
     failed_at_ = faces.size();
     failure_ = nullptr;
-    detail::par_for(threaded_ && mine_.size() >= 64, 0, index_t(mine_.size()), [&](index_t m) {
+    detail::par_for(threaded_ && mine_.size() >= threaded_faces, 0, index_t(mine_.size()), [&](index_t m) {
       const std::size_t pi = std::size_t(mine_[std::size_t(m)]);
       double* r = records_.data() + pi * std::size_t(W);
       try {

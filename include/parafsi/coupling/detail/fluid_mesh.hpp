@@ -185,12 +185,6 @@ double local_width(const F& f, const Eigen::Vector3d& xi) {
 class face_space {
  public:
   face_space() = default;
-  template <class F>
-  static face_space of(const F& f) {
-    face_space s;
-    s.refresh(f);
-    return s;
-  }
   /// Follow the fluid's mesh (every step: a regrid may have changed it); the index grid is
   /// rebuilt only when the finest level's extent changed, so a step allocates nothing.
   template <class F>

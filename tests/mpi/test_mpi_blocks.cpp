@@ -413,3 +413,94 @@ TEST_CASE("a patched face that fails stops every process, the first failing face
   long one = 1;
   CHECK(sum_over_processes(one) == P);
 }
+
+namespace {
+/// The same weights on every process (their bits: the minimum and maximum over processes).
+bool same_everywhere(const std::vector<double>& w) {
+  double sum = 0.0;
+  for (double x : w) sum += x;
+  double lo[2] = {sum, double(w.size())}, hi[2] = {sum, double(w.size())};
+  MPI_Allreduce(MPI_IN_PLACE, lo, 2, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, hi, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return lo[0] == hi[0] && lo[1] == hi[1];
+}
+}  // namespace
+
+TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a rebalance and a regrid, bitwise") {
+  // A block made expensive (add_block_cost, as the drop adds its wall distance) gets a
+  // process of its own at the next partition; the weights are the same on every process,
+  // a regrid carries them to the new leaves, and the state keeps the one-process bits.
+  const int P = world_size();
+  fluid::block_layout lay{{0, 0, 0}, {8, 8, 2}, {4, 4, 1}, 8};
+  fluid::reference::isentropic_vortex v{};
+  v.cx = 5.0;
+  v.cy = 5.0;
+  v.u_inf = 1.0;
+  v.period = 8.0;
+  const auto t0 = refined_tree({4, 4, 1}, {true, true, true}, lay, {5.0, 5.0, 1.0}, 1.0, 2);
+  auto make = [&] {
+    auto s = std::make_unique<fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::mc>>>(
+        t0, lay, pf::boundary::set::all(pf::boundary::periodic{}));
+    s->initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
+    return s;
+  };
+  auto serial = make();
+  auto dist = make();
+  dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  CHECK(dist->partition_weights() == std::vector<double>(std::size_t(dist->block_count()), 1.0));
+  const fb::location corner{0, {0, 0, 0}};  // a root block far from the refined region
+  auto computes = [&](index_t id) {
+    const auto& m = dist->computed_blocks();
+    return std::find(m.begin(), m.end(), id) != m.end();
+  };
+  auto steps = [&](int k) {
+    for (int n = 0; n < k; ++n) {
+      const double dt = serial->stable_dt(0.5);
+      CHECK(dist->stable_dt(0.5) == dt);
+      serial->step(dt);
+      dist->step(dt);
+    }
+  };
+  steps(4);
+  const index_t heavy = dist->tree().id_of(corner);
+  REQUIRE(heavy == 0);
+  if (computes(heavy)) dist->add_block_cost(heavy, 100.0);
+  dist->rebalance();
+  const std::vector<double> w = dist->partition_weights();
+  CHECK(same_everywhere(w));
+  if (P > 1) {
+    CHECK(w[std::size_t(heavy)] == doctest::Approx(25.0).epsilon(0.01));  // 100 s over 4 steps (+ its µs)
+    for (std::size_t b = 1; b < w.size(); ++b) CHECK((w[b] > 0.0 && w[b] < 1.0));
+    if (world_rank() == 0) CHECK(dist->computed_blocks() == std::vector<index_t>{heavy});
+  } else {
+    CHECK(w == std::vector<double>(w.size(), 1.0));  // one process computes everything: nothing to weigh
+  }
+  steps(4);
+  // A regrid that moves the refined region: the corner block stays a leaf and keeps its cost.
+  if (computes(dist->tree().id_of(corner))) dist->add_block_cost(dist->tree().id_of(corner), 100.0);
+  auto target = [&](const fb::location& q) {
+    double d2 = 0;
+    const double c[2] = {6.0, 5.0};
+    for (int d = 0; d < 2; ++d) {
+      const double wd = lay.block_width(d, q.level), a = wd * double(q.l[std::size_t(d)]);
+      const double e = std::clamp(c[d], a, a + wd) - c[d];
+      d2 += e * e;
+    }
+    return d2 < 1.0 ? 2 : (d2 < 4.0 ? 1 : 0);
+  };
+  const bool a = serial->regrid(target, 2);
+  const bool b = dist->regrid(target, 2);
+  REQUIRE(a);
+  REQUIRE(b);
+  const std::vector<double> w2 = dist->partition_weights();
+  CHECK(w2.size() == std::size_t(dist->block_count()));
+  CHECK(same_everywhere(w2));
+  if (P > 1) {
+    CHECK(w2[std::size_t(dist->tree().id_of(corner))] == doctest::Approx(25.0).epsilon(0.01));
+    if (world_rank() == 0) CHECK(dist->computed_blocks() == std::vector<index_t>{dist->tree().id_of(corner)});
+  }
+  steps(4);
+  dist->gather();
+  CHECK(mismatches(state_of(*serial), state_of(*dist)) == 0);
+  CHECK(same_totals(serial->totals(), dist->totals()));
+}

@@ -29,6 +29,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -387,6 +388,35 @@ class block_solver {
   void share_cells(const std::vector<index_t>& cells) { share_slots(cells, false); }
   /// The blocks this process computes (tree order): all without a halo.
   const std::vector<index_t>& computed_blocks() const noexcept { return computed_; }
+  /// Add `seconds` to the measured cost of computed block `id` (distributed runs; ignored
+  /// without a halo): a caller's own per-block work, e.g. the drop's wall distance, so the
+  /// partition weighs it too. Safe from threads working on different blocks.
+  void add_block_cost(index_t id, double seconds) noexcept {
+    if (halo_) cost_[std::size_t(id)] += seconds;
+  }
+  /// The weight of each block in the last partition (tree order; every process the same):
+  /// 1 until the first repartition, then the blocks' measured seconds per step (see
+  /// rebalance()).
+  std::vector<double> partition_weights() const {
+    return weight_.size() == blocks_.size() ? weight_ : std::vector<double>(blocks_.size(), 1.0);
+  }
+  /// Cut the mesh again by the blocks' measured cost (collective; a no-op without a halo).
+  /// Each process times the work of the blocks it computes (their sweeps, viscous pass,
+  /// corrections, sources and update, the coupling faces whose high cell they hold, and
+  /// what the caller adds with add_block_cost); the seconds per step since the last
+  /// partition, gathered to every process, become the block weights of blocks::partition.
+  /// A regrid that changes the mesh does this itself (a new leaf weighs what the old leaf
+  /// covering it did, or the mean of the old leaves it merges); this call is for a mesh
+  /// that stays. Replicated blocks (halo::everywhere) weigh the mean of the others. The
+  /// state is gathered first (a block may change process), so this costs a regrid's
+  /// gather; the results do not change by a bit, only who computes what.
+  void rebalance() {
+    if (!halo_) return;
+    reattach_if_moved();
+    gather();
+    weight_ = measured_weights(tree_);
+    attach_halo();
+  }
   /// Every block's interior cells from its owner to every process (collective; a no-op
   /// when not distributed).
   void gather() {
@@ -403,7 +433,7 @@ class block_solver {
     m.corrections = &corrections_;
     m.U = &U_all_;
     m.registers.resize(blocks_.size());
-    m.weight.assign(blocks_.size(), 1.0);
+    m.weight = weight_.size() == blocks_.size() ? weight_ : std::vector<double>(blocks_.size(), 1.0);
     for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces.data();
     if constexpr (has_eddy_viscosity) {
       m.mu_t.resize(blocks_.size());
@@ -460,6 +490,7 @@ class block_solver {
     if (pose_time != 1.0) pose_.advance((1.0 - pose_time) * dt);
     t_ += dt;
     ++steps_;
+    ++cost_steps_;
   }
   template <face_patcher Patcher>
   void step(double dt, Patcher& patcher) {
@@ -539,6 +570,7 @@ class block_solver {
       std::array<bool, 3> per{self.tree_.periodic(0), self.tree_.periodic(1), self.tree_.periodic(2)};
       self.tree_ = blocks::tree::from_leaves(self.layout_.root_blocks, per, list);
       self.sources_on_ = self.sources_on_ || sources;
+      self.weight_.clear();  // a new mesh: uniform weights until costs are measured
       self.build();
     }
     ar.fields("conserved", *self.U_);
@@ -625,6 +657,7 @@ class block_solver {
     const std::unique_ptr<turbulence_storage> old_T = std::move(T_);
     blocks::tree old_tree = std::move(tree_);
     tree_ = std::move(next);
+    if (halo_) weight_ = measured_weights(old_tree);  // the old mesh's costs, on the new leaves
     build();
     transfer(old, old_tree);
     if constexpr (has_eddy_viscosity) transfer_eddy_viscosity(old, old_tree);
@@ -731,6 +764,8 @@ class block_solver {
   void attach_halo() {
     computed_.clear();
     attached_to_ = this;
+    cost_.assign(blocks_.size(), 0.0);  // measured anew for the next partition
+    cost_steps_ = 0;
     if (halo_) computed_ = halo_->rebuild(mesh_view());
     else
       for (index_t id = 0; id < block_count(); ++id) computed_.push_back(id);
@@ -778,6 +813,62 @@ class block_solver {
     return r;
   }
 
+  /// f(), its seconds added to block id's measured cost when distributed (rebalance()).
+  template <class F>
+  void costed(index_t id, F&& f) {
+    if (!halo_) {
+      f();
+      return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    cost_[std::size_t(id)] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  /// Weights of tree_'s leaves from the costs measured on the mesh `old` (the current one
+  /// before a regrid; computed_, cost_ and the halo still describe it), the same on every
+  /// process (collective): seconds per step of each block, gathered from the processes
+  /// computing them; a new leaf takes the weight of the old leaf covering it, or the mean of
+  /// the old leaves one level finer it merges; replicated or unmeasured blocks the mean.
+  std::vector<double> measured_weights(const blocks::tree& old) {
+    const std::size_t nold = std::size_t(old.size());
+    std::vector<double> per(nold, 0.0);
+    const double steps = double(std::max<long>(1, cost_steps_));
+    for (index_t id : computed_)
+      if (!halo_->everywhere(id)) per[std::size_t(id)] = cost_[std::size_t(id)] / steps;
+    halo_->gather_blocks(per, 1);
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t b = 0; b < nold; ++b) {
+      if (halo_->everywhere(index_t(b)) || !(per[b] > 0.0 && std::isfinite(per[b]))) per[b] = -1.0;
+      else {
+        sum += per[b];
+        ++count;
+      }
+    }
+    const double mean = count > 0 ? sum / double(count) : 1.0;
+    std::vector<double> w(std::size_t(tree_.size()), mean);
+    for (index_t id = 0; id < tree_.size(); ++id) {
+      const blocks::location q = tree_.leaf(id);
+      const blocks::cover c = old.find(q);
+      if (c.kind == blocks::cover::leaf) {
+        if (per[std::size_t(c.id)] > 0.0) w[std::size_t(id)] = per[std::size_t(c.id)];
+      } else if (c.kind == blocks::cover::finer) {
+        double s = 0.0;
+        int k = 0;
+        for (int o = 0; o < 8; ++o) {
+          const blocks::cover f = old.find(q.child(o));
+          if (f.kind == blocks::cover::leaf && f.level == q.level + 1 && per[std::size_t(f.id)] > 0.0) {
+            s += per[std::size_t(f.id)];
+            ++k;
+          }
+        }
+        if (k > 0) w[std::size_t(id)] = s / double(k);
+      }
+    }
+    return w;
+  }
+
   /// U⁰ ← U on every block's span from its first to its last interior cell (the update
   /// reads the interior cells only).
   void save_stage_start() {
@@ -816,10 +907,10 @@ class block_solver {
     // Ghosts, then the sweeps, of the owned blocks in `ids`; the coarse–fine corrections.
     auto ghosts_and_sweeps = [&](const std::vector<index_t>& ids) {
       timed(times_.boundaries, [&] { fill_ghosts(t, ids); });
-      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { sweep_block(id, geo); }); });
+      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { costed(id, [&] { sweep_block(id, geo); }); }); });
     };
     auto corrections = [&](const std::vector<index_t>& ids) {
-      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { correct_fluxes(id); }); });
+      timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { costed(id, [&] { correct_fluxes(id); }); }); });
     };
     if (halo_) {
       // Each exchange travels while blocks that do not wait for it are worked on: the
@@ -842,7 +933,7 @@ class block_solver {
     }
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
-      timed(times_.sources, [&] { for_computed([&](index_t id) { add_sources(id); }); });
+      timed(times_.sources, [&] { for_computed([&](index_t id) { costed(id, [&] { add_sources(id); }); }); });
   }
 
   /// Primitives and the three flux sweeps of block id (and its viscous pass), keeping its
@@ -1034,11 +1125,14 @@ class block_solver {
     std::mutex failing;
     failed_at_ = faces.size();
     failure_ = nullptr;
+    face_seconds_.assign(mine_.size(), 0.0);
     detail::par_for(threaded_ && mine_.size() >= threaded_faces, 0, index_t(mine_.size()), [&](index_t m) {
       const std::size_t pi = std::size_t(mine_[std::size_t(m)]);
       double* r = records_.data() + pi * std::size_t(W);
       try {
+        const auto t0 = std::chrono::steady_clock::now();
         solve_face<OneSided>(geo, stage, patcher, faces, pi, state, r);
+        face_seconds_[std::size_t(m)] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       } catch (...) {
         r[face_record::area] = -1.0;
         const std::lock_guard<std::mutex> lock(failing);
@@ -1048,7 +1142,11 @@ class block_solver {
         }
       }
     });
-    if (halo_) halo_->gather_items(record_block_, records_, W);
+    if (halo_) {
+      for (std::size_t m = 0; m < mine_.size(); ++m)  // each face's time to its high cell's block
+        cost_[std::size_t(record_block_[std::size_t(mine_[m])])] += face_seconds_[m];
+      halo_->gather_items(record_block_, records_, W);
+    }
   }
 
   /// Face pi solved into its record r.
@@ -1449,12 +1547,14 @@ class block_solver {
   void update(double a, double bcoef, double dt, double t_new, bool last) {
     detail::timed(times_.update, [&] {
       for_computed([&](index_t id) {
-        block& b = blocks_[std::size_t(id)];
-        const auto U = detail::conserved_ptrs(b.U);
-        const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
-        const auto dU = detail::conserved_ptrs(std::as_const(b.dU));
-        if (last) detail::update<true>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
-        else detail::update<false>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
+        costed(id, [&] {
+          block& b = blocks_[std::size_t(id)];
+          const auto U = detail::conserved_ptrs(b.U);
+          const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
+          const auto dU = detail::conserved_ptrs(std::as_const(b.dU));
+          if (last) detail::update<true>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
+          else detail::update<false>(b.grid, gas_, U, U0, dU, a, bcoef, dt, b.bad_rows.data(), false);
+        });
       });
       if (last)
         for (index_t id : computed_) {
@@ -1514,6 +1614,11 @@ class block_solver {
   std::vector<index_t> remote_ids_;          ///< ghosts read remote cells; their registers stay here
   std::vector<index_t> correct_local_ids_;   ///< corrections read local registers only (all without a halo)
   std::vector<index_t> correct_remote_ids_;  ///< corrections read remote registers
+  // Cost-weighted partition (distributed runs; rebalance()):
+  std::vector<double> cost_;          ///< per block: seconds of its work since the last partition (computed blocks)
+  long cost_steps_ = 0;               ///< steps since the last partition
+  std::vector<double> weight_;        ///< per block: its weight in the last partition (empty: uniform)
+  std::vector<double> face_seconds_;  ///< solve_faces: seconds of each face this process solved
 };
 
 template <policy... Ps>

@@ -719,8 +719,10 @@ class drop_run {
         // closure's for the block's Δ = (h_x h_y h_z)^(1/3) (its widths, ghosts included, at
         // their largest): the same eddy viscosity, at a fraction of the cost on fine blocks.
         const std::vector<index_t>& ids = f.computed_blocks();
+        // Each block's seconds count in its partition weight (block_solver::rebalance).
         parallel::for_range(0, index_t(ids.size()), [&](index_t k) {
           const index_t id = ids[std::size_t(k)];
+          const auto t0 = std::chrono::steady_clock::now();
           const auto& g = f.block_at(id).grid;
           double hmax[3];
           for (int d = 0; d < 3; ++d) {
@@ -730,6 +732,7 @@ class drop_run {
           }
           fluid::distance_to_points(g, wall_points_, ml.wall_reach(std::cbrt(hmax[0] * hmax[1] * hmax[2])),
                                     std::span<double>(f.wall_distance(id), std::size_t(g.total_cells())), true);
+          f.add_block_cost(id, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         });
       } else {
         fluid::distance_to_points(f.grid(), wall_points_, ml.wall_reach(std::numeric_limits<double>::infinity()),

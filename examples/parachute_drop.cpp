@@ -156,6 +156,11 @@ int main(int argc, char** argv) {
       ->check(finite)
       ->check(CLI::Range(0.3, 50.0))
       ->capture_default_str();
+  app.add_option("--grid-offset", c.grid_offset,
+                 "shift of the fluid grid along the box axis, in finest cells (an ensemble over the grid's placement)")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
   app.add_option("--growth", c.growth, "cell growth factor outside the refined region (default: the resolution's)")
       ->check(finite)
       ->check(CLI::Range(1.0, 2.0));

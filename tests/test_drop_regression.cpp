@@ -256,6 +256,9 @@ TEST_CASE("drop config: silently dropped settings are refused by name") {
   refused(c, "--slice-times 0.0123 s is not an output instant (a multiple of --history-every");
   c.slice_times = {0.2, 0.1};
   refused(c, "--slice-times must be in increasing order");
+  c = cfg{};
+  c.grid_offset = 1.0;
+  refused(c, "the grid offset must be in [0, 1) cells, got 1");
 }
 
 // Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the

@@ -397,6 +397,22 @@ TEST_CASE("drop box: extents, refined block, axes and size from the scene") {
   CHECK(f.fine_hi[2] == b.fine_hi[2]);
   CHECK(f.fall == 10.0);
 
+  // A grid offset moves the box and its refined block along the axis by offset · h, the
+  // rest unchanged; outside [0, 1) cells it is refused by value.
+  bp.fall = 0.0;
+  bp.offset = 0.25;
+  const md::drop_box o = md::make_drop_box(s, bp);
+  const double dz = 0.25 * 0.0667;
+  CHECK(o.lo[2] == doctest::Approx(b.lo[2] + dz).epsilon(1e-14));
+  CHECK(o.hi[2] == doctest::Approx(b.hi[2] + dz).epsilon(1e-14));
+  CHECK(o.fine_lo[2] == doctest::Approx(b.fine_lo[2] + dz).epsilon(1e-14));
+  CHECK(o.fine_hi[2] == doctest::Approx(b.fine_hi[2] + dz).epsilon(1e-14));
+  CHECK((o.lo[0] == b.lo[0] && o.hi[1] == b.hi[1] && o.fine_lo[0] == b.fine_lo[0]));
+  bp.offset = 1.0;
+  CHECK_THROWS_WITH_AS(md::make_drop_box(s, bp), doctest::Contains("grid offset must be in [0, 1) cells, got 1"),
+                       pf::invalid_input);
+  bp.offset = 0.0;
+
   // A slanted flight path: orthonormal axes, z_b along the canopy axis, y_b = ŷ (the
   // horizontal normal of the flight plane x–z).
   auto Q = P;

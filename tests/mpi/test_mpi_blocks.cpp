@@ -415,18 +415,20 @@ TEST_CASE("a patched face that fails stops every process, the first failing face
 }
 
 namespace {
-/// The same weights on every process (their bits: the minimum and maximum over processes).
+/// The same weights on every process: each entry's minimum and maximum over the processes
+/// are equal (the same count on every process first).
 bool same_everywhere(const std::vector<double>& w) {
-  double sum = 0.0;
-  for (double x : w) sum += x;
-  double lo[2] = {sum, double(w.size())}, hi[2] = {sum, double(w.size())};
-  MPI_Allreduce(MPI_IN_PLACE, lo, 2, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(MPI_IN_PLACE, hi, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return lo[0] == hi[0] && lo[1] == hi[1];
+  long n[2] = {long(w.size()), -long(w.size())};
+  MPI_Allreduce(MPI_IN_PLACE, n, 2, MPI_LONG, MPI_MIN, MPI_COMM_WORLD);
+  if (n[0] != -n[1]) return false;
+  std::vector<double> lo = w, hi = w;
+  MPI_Allreduce(MPI_IN_PLACE, lo.data(), int(lo.size()), MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, hi.data(), int(hi.size()), MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
 }
 }  // namespace
 
-TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a rebalance and a regrid, bitwise") {
+TEST_CASE("cost-weighted partition: measured block costs cut the mesh at regrids and rebalance(), bitwise") {
   // A block made expensive (add_block_cost, as the drop adds its wall distance) gets a
   // process of its own at the next partition; the weights are the same on every process,
   // a regrid carries them to the new leaves, and the state keeps the one-process bits.
@@ -449,6 +451,24 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a
   dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
   CHECK(dist->partition_weights() == std::vector<double>(std::size_t(dist->block_count()), 1.0));
   const fb::location corner{0, {0, 0, 0}};  // a root block far from the refined region
+  // A regrid that changes the mesh before any step (as the drop's first refinement does):
+  // nothing is measured yet, so the weights stay uniform and the first cut by measured cost
+  // is still to come.
+  auto around = [&](double cx) {
+    return [&lay, cx](const fb::location& q) {
+      double d2 = 0;
+      const double c[2] = {cx, 5.0};
+      for (int d = 0; d < 2; ++d) {
+        const double wd = lay.block_width(d, q.level), a = wd * double(q.l[std::size_t(d)]);
+        const double e = std::clamp(c[d], a, a + wd) - c[d];
+        d2 += e * e;
+      }
+      return d2 < 1.0 ? 2 : (d2 < 4.0 ? 1 : 0);
+    };
+  };
+  REQUIRE(serial->regrid(around(5.0), 2));
+  REQUIRE(dist->regrid(around(5.0), 2));
+  CHECK(dist->partition_weights() == std::vector<double>(std::size_t(dist->block_count()), 1.0));
   auto computes = [&](index_t id) {
     const auto& m = dist->computed_blocks();
     return std::find(m.begin(), m.end(), id) != m.end();
@@ -465,7 +485,14 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a
   const index_t heavy = dist->tree().id_of(corner);
   REQUIRE(heavy == 0);
   if (computes(heavy)) dist->add_block_cost(heavy, 100.0);
-  dist->rebalance();
+  // A regrid that keeps the mesh: the first one after set_halo cuts by the measured costs.
+  const fb::tree mesh0 = dist->tree();
+  auto same_mesh = [&](const fb::location& q) {
+    const fb::cover c = mesh0.find(q);
+    return c.kind == fb::cover::leaf ? c.level : q.level + 1;
+  };
+  CHECK_FALSE(serial->regrid(same_mesh, 2));
+  CHECK_FALSE(dist->regrid(same_mesh, 2));
   const std::vector<double> w = dist->partition_weights();
   CHECK(same_everywhere(w));
   if (P > 1) {
@@ -478,18 +505,8 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a
   steps(4);
   // A regrid that moves the refined region: the corner block stays a leaf and keeps its cost.
   if (computes(dist->tree().id_of(corner))) dist->add_block_cost(dist->tree().id_of(corner), 100.0);
-  auto target = [&](const fb::location& q) {
-    double d2 = 0;
-    const double c[2] = {6.0, 5.0};
-    for (int d = 0; d < 2; ++d) {
-      const double wd = lay.block_width(d, q.level), a = wd * double(q.l[std::size_t(d)]);
-      const double e = std::clamp(c[d], a, a + wd) - c[d];
-      d2 += e * e;
-    }
-    return d2 < 1.0 ? 2 : (d2 < 4.0 ? 1 : 0);
-  };
-  const bool a = serial->regrid(target, 2);
-  const bool b = dist->regrid(target, 2);
+  const bool a = serial->regrid(around(6.0), 2);
+  const bool b = dist->regrid(around(6.0), 2);
   REQUIRE(a);
   REQUIRE(b);
   const std::vector<double> w2 = dist->partition_weights();
@@ -499,6 +516,13 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh, through a
     CHECK(w2[std::size_t(dist->tree().id_of(corner))] == doctest::Approx(25.0).epsilon(0.01));
     if (world_rank() == 0) CHECK(dist->computed_blocks() == std::vector<index_t>{dist->tree().id_of(corner)});
   }
+  steps(4);
+  // rebalance() on a mesh that stays: the last block made expensive gets the last process.
+  const index_t last = dist->block_count() - 1;
+  if (computes(last)) dist->add_block_cost(last, 100.0);
+  dist->rebalance();
+  CHECK(same_everywhere(dist->partition_weights()));
+  if (P > 1 && world_rank() == P - 1) CHECK(dist->computed_blocks() == std::vector<index_t>{last});
   steps(4);
   dist->gather();
   CHECK(mismatches(state_of(*serial), state_of(*dist)) == 0);

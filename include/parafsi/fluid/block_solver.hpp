@@ -375,6 +375,7 @@ class block_solver {
   /// the blocks this process computes (computed_blocks(), ghosts included).
   void set_halo(std::shared_ptr<blocks::halo> h) {
     halo_ = std::move(h);
+    weight_.clear();   // a new split: uniform until costs are measured
     gathered_ = true;  // the caller's promise: every process holds the same state
     attach_halo();
   }
@@ -406,12 +407,13 @@ class block_solver {
   /// what the caller adds with add_block_cost); the seconds per step since the last
   /// partition, gathered to every process, become the block weights of blocks::partition.
   /// A regrid that changes the mesh does this itself (a new leaf weighs what the old leaf
-  /// covering it did, or the mean of the old leaves it merges); this call is for a mesh
-  /// that stays. Replicated blocks (halo::everywhere) weigh the mean of the others. The
-  /// state is gathered first (a block may change process), so this costs a regrid's
+  /// covering it did, or the mean of the old leaves it merges), and so does the first
+  /// regrid call that leaves the mesh as it is while the partition still weighs every
+  /// block 1 (after set_halo or a restart); this call is for a mesh that stays. Replicated blocks (halo::everywhere)
+  /// weigh the mean of the others. The state is gathered first (a block may change process), so this costs a regrid's
   /// gather; the results do not change by a bit, only who computes what.
   void rebalance() {
-    if (!halo_) return;
+    if (!halo_ || halo_->size() == 1) return;
     reattach_if_moved();
     gather();
     weight_ = measured_weights(tree_);
@@ -626,6 +628,9 @@ class block_solver {
   /// old mesh, ghosts included, offsets of the fine centres in coarse widths, so the
   /// children average back to the parent), a new coarser leaf the volume mean of the old
   /// cells it covers. Levels are capped at max_level. Returns whether the mesh changed.
+  /// Distributed, a call may change the blocks this process computes even when it returns
+  /// false (the first cut by measured cost, see rebalance()): refresh per-block data of your
+  /// own (e.g. a wall distance) from computed_blocks() before the next step.
   template <class Target>
   bool regrid(Target&& target, int max_level) {
     require(max_level >= 0 && max_level <= blocks::tree::max_depth,
@@ -649,7 +654,12 @@ class block_solver {
         if (all && next.coarsen(p)) merged = true;
       }
     }
-    if (next.leaves() == tree_.leaves()) return false;
+    if (next.leaves() == tree_.leaves()) {
+      // The first partition weighed every block 1; once costs are measured, cut by them
+      // (once: later partitions come with the regrids that change the mesh, or rebalance()).
+      if (halo_ && halo_->size() > 1 && weight_.empty() && cost_steps_ > 0) rebalance();
+      return false;
+    }
     gather();  // a distributed mesh: every process moves every block (the mesh is replicated)
     fill_ghosts_all(t_, 0, block_count());  // the old mesh's ghosts feed the prolongation slopes
     std::vector<block> old = std::move(blocks_);
@@ -658,6 +668,7 @@ class block_solver {
     blocks::tree old_tree = std::move(tree_);
     tree_ = std::move(next);
     if (halo_) weight_ = measured_weights(old_tree);  // the old mesh's costs, on the new leaves
+    else weight_.clear();
     build();
     transfer(old, old_tree);
     if constexpr (has_eddy_viscosity) transfer_eddy_viscosity(old, old_tree);
@@ -828,15 +839,20 @@ class block_solver {
   /// Weights of tree_'s leaves from the costs measured on the mesh `old` (the current one
   /// before a regrid; computed_, cost_ and the halo still describe it), the same on every
   /// process (collective): seconds per step of each block, gathered from the processes
-  /// computing them; a new leaf takes the weight of the old leaf covering it, or the mean of
-  /// the old leaves one level finer it merges; replicated or unmeasured blocks the mean.
+  /// computing them (without a step since the last cut, the last weights; none: empty,
+  /// uniform); a new leaf takes the weight of the old leaf covering it, or the mean of the
+  /// old leaves one level finer it merges; replicated or unmeasured blocks the mean.
   std::vector<double> measured_weights(const blocks::tree& old) {
     const std::size_t nold = std::size_t(old.size());
     std::vector<double> per(nold, 0.0);
-    const double steps = double(std::max<long>(1, cost_steps_));
-    for (index_t id : computed_)
-      if (!halo_->everywhere(id)) per[std::size_t(id)] = cost_[std::size_t(id)] / steps;
-    halo_->gather_blocks(per, 1);
+    if (cost_steps_ == 0) {                   // no step since the last cut (the same on every process)
+      if (weight_.size() != nold) return {};  // nothing measured yet: uniform
+      per = weight_;                          // carry the last weights onto the new leaves
+    } else {
+      for (index_t id : computed_)
+        if (!halo_->everywhere(id)) per[std::size_t(id)] = cost_[std::size_t(id)] / double(cost_steps_);
+      halo_->gather_blocks(per, 1);
+    }
     double sum = 0.0;
     long count = 0;
     for (std::size_t b = 0; b < nold; ++b) {

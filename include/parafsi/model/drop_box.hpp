@@ -16,6 +16,10 @@
 /// `fall` > 0 is the fixed box of the following-box study: the following box at the start,
 /// lengthened downwards by the fall (m) it must hold, with the refined column lengthened by
 /// the same amount.
+/// `offset` shifts the whole box (extents and refined block) by offset · h along the axis:
+/// the same grid placed differently about the canopy by a fraction of a cell, for an
+/// ensemble over the grid's placement (an under-resolved packed canopy's opening depends on
+/// where it sits in its cells; docs/validation.md §8.1).
 /// Axes: z_b = the scene's canopy axis, x_b = ŷ × z_b normalised (x̂ if the axis is along ŷ),
 /// y_b = z_b × x_b; `axes` holds them as columns (the box pose's R).
 ///
@@ -72,6 +76,7 @@ struct drop_box_parameters {
   double refined_radius = 0.6;  ///< refined block half-width / D0
   double refined_below = 0.55;  ///< refined block start above the confluence / Ls
   double refined_above = 0.55;  ///< refined block end above the point Ls beyond the confluence / D0
+  double offset = 0.0;          ///< shift of the box along its axis, in cells h, in [0, 1)
   double max_cells = 5e7;       ///< largest box accepted (cells)
   double bytes_per_cell = 300;  ///< memory estimate per cell (for the size message)
 
@@ -88,6 +93,7 @@ struct drop_box_parameters {
     require(std::isfinite(refined_below) && std::isfinite(refined_above),
             "model::drop_box: refined block bounds must be finite, got ", refined_below, " and ", refined_above);
     require(positive(max_cells), "model::drop_box: max_cells must be > 0, got ", max_cells);
+    require(offset >= 0.0 && offset < 1.0, "model::drop_box: the grid offset must be in [0, 1) cells, got ", offset);
   }
 };
 
@@ -138,6 +144,8 @@ inline drop_box make_drop_box(const drop_scene& s, const drop_box_parameters& p)
   b.hi = {half, half, zhi};
   b.fine_lo = {-p.refined_radius * D0, -p.refined_radius * D0, std::max(zlo, rz0)};
   b.fine_hi = {p.refined_radius * D0, p.refined_radius * D0, std::min(zhi, rz1)};
+  const double shift = p.offset * p.cell * D0;
+  for (double* z : {&b.lo[2], &b.hi[2], &b.fine_lo[2], &b.fine_hi[2]}) *z += shift;
   b.cell = p.cell * D0;
   b.growth = p.growth;
   b.fall = fall;

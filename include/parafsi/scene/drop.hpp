@@ -123,8 +123,9 @@ struct drop_config {
   double history_every = 0.005;  ///< output interval (s)
   double force_cutoff = 10.0;    ///< riser-force filter cut-off (Hz): open_force_filtered, F_p, t_p
   double box_width = 5.0, box_length = 7.0, box_ahead = 1.5;  ///< fluid box / D0 (model::drop_box_parameters)
-  double growth = 0;  ///< cell growth factor outside the refined block; 0 = the resolution's
-  double cfl = 0.9;   ///< CFL number of the fluid step
+  double grid_offset = 0.0;  ///< shift of the fluid grid along the box axis, in finest cells, in [0, 1)
+  double growth = 0;         ///< cell growth factor outside the refined block; 0 = the resolution's
+  double cfl = 0.9;          ///< CFL number of the fluid step
   double pfac = 1.0, stiffening = 0.25, coupling_damping = 0.0;  ///< penalty: PFAC, λ, damping ratio
   double membrane_damping = 0.05;                                ///< membrane damping ratio of its highest mode
   double impedance = 1.0;  ///< embedded: impedance (added-mass) stabilisation factor ζ
@@ -339,6 +340,7 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   bp.cell = R.cell;
   bp.growth = R.growth;
   bp.fall = su.fixed_box ? c.fixed_fall : 0.0;
+  bp.offset = c.grid_offset;
   try {
     su.box = model::make_drop_box(su.scene, bp);
   } catch (const invalid_input& e) {
@@ -376,6 +378,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
   g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
   g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
+  if (c.grid_offset != 0.0) g.add("grid_offset", c.grid_offset);
   if (c.mesh == "blocks")
     g.add("mesh", c.mesh)
         .add("block_size", std::int64_t(c.block_size))

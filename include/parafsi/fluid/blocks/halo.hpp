@@ -5,7 +5,8 @@
 /// Every process keeps the whole tree, its exchange plans and flux corrections, and storage
 /// for every block (the mesh's metadata is small; the storage is replicated for now, see
 /// docs/guide_mpi.md), but computes only the blocks it owns: a contiguous range of the
-/// leaves' Morton order, cut by cost (`partition`), and the blocks every process computes
+/// leaves' Morton order, cut by cost (`partition`, with the blocks' measured seconds per
+/// step as weights: fluid::block_solver::rebalance), and the blocks every process computes
 /// (optionally, e.g. for coupling::penalty: the finest level, where a coupling reads and
 /// writes the air). A stage of the block solver then reads four kinds of data another
 /// process computed:

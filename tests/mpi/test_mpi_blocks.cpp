@@ -439,7 +439,7 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh at regrids
   v.cy = 5.0;
   v.u_inf = 1.0;
   v.period = 8.0;
-  const auto t0 = refined_tree({4, 4, 1}, {true, true, true}, lay, {5.0, 5.0, 1.0}, 1.0, 2);
+  const fb::tree t0({4, 4, 1}, {true, true, true});  // the root grid: the first regrid refines it
   auto make = [&] {
     auto s = std::make_unique<fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::mc>>>(
         t0, lay, pf::boundary::set::all(pf::boundary::periodic{}));

@@ -29,7 +29,6 @@
 #pragma once
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -409,9 +408,10 @@ class block_solver {
   /// A regrid that changes the mesh does this itself (a new leaf weighs what the old leaf
   /// covering it did, or the mean of the old leaves it merges), and so does the first
   /// regrid call that leaves the mesh as it is while the partition still weighs every
-  /// block 1 (after set_halo or a restart); this call is for a mesh that stays. Replicated blocks (halo::everywhere)
-  /// weigh the mean of the others. The state is gathered first (a block may change process), so this costs a regrid's
-  /// gather; the results do not change by a bit, only who computes what.
+  /// block 1 (after set_halo or a restart); this call is for a mesh that stays.
+  /// Replicated blocks (halo::everywhere) weigh the mean of the others. The state is
+  /// gathered first (a block may change process), so this costs a regrid's gather; the
+  /// results do not change by a bit, only who computes what.
   void rebalance() {
     if (!halo_ || halo_->size() == 1) return;
     reattach_if_moved();
@@ -827,13 +827,8 @@ class block_solver {
   /// f(), its seconds added to block id's measured cost when distributed (rebalance()).
   template <class F>
   void costed(index_t id, F&& f) {
-    if (!halo_) {
-      f();
-      return;
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    cost_[std::size_t(id)] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (halo_) detail::timed(cost_[std::size_t(id)], f);
+    else f();
   }
 
   /// Weights of tree_'s leaves from the costs measured on the mesh `old` (the current one
@@ -1146,9 +1141,8 @@ class block_solver {
       const std::size_t pi = std::size_t(mine_[std::size_t(m)]);
       double* r = records_.data() + pi * std::size_t(W);
       try {
-        const auto t0 = std::chrono::steady_clock::now();
-        solve_face<OneSided>(geo, stage, patcher, faces, pi, state, r);
-        face_seconds_[std::size_t(m)] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        detail::timed(face_seconds_[std::size_t(m)],
+                      [&] { solve_face<OneSided>(geo, stage, patcher, faces, pi, state, r); });
       } catch (...) {
         r[face_record::area] = -1.0;
         const std::lock_guard<std::mutex> lock(failing);

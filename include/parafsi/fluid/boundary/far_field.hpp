@@ -5,7 +5,8 @@
 ///   R⁺ = U_i + 2c_i/(γ−1),  R⁻ = U_∞ − 2c_∞/(γ−1),
 ///   U_b = ½(R⁺ + R⁻),  c_b = ¼(γ−1)(R⁺ − R⁻);
 /// entropy s = p/ρ^γ and tangential velocity from ∞ on inflow (U_b < 0), from the
-/// interior on outflow; ρ_b = (c_b²/(γ s))^{1/(γ−1)}, p_b = ρ_b c_b²/γ,
+/// interior on outflow; ρ_b = (c_b²/(γ s))^{1/(γ−1)} (computed as ρ_s (c_b²/c_s²)^{1/(γ−1)},
+/// one power), p_b = ρ_b c_b²/γ,
 /// u_b = u_t + (U_b + w_n) n. Supersonic faces take the upwind state. Non-reflecting
 /// for normally incident acoustic waves; pair it with a sponge layer for vortices.
 /// Reference: Blazek J. (2015) Computational Fluid Dynamics: Principles and
@@ -34,8 +35,8 @@ struct far_field {
     const double Ub = 0.5 * (Rp + Rm), cb = 0.25 * gm1 * (Rp - Rm);
     const bool inflow = Ub < 0.0;
     const fluid::prim<double>& src = inflow ? fluid::prim<double>{rho, u, p} : in;
-    const double s = src.p / std::pow(src.rho, g.gamma);
-    const double rb = std::pow(cb * cb / (g.gamma * s), 1.0 / gm1);
+    // On the isentrope of src (s = p/ρ^γ = c²ρ^(1−γ)/γ): ρ_b = ρ_src (c_b²/c_src²)^{1/(γ−1)}.
+    const double rb = src.rho * std::pow(cb * cb * src.rho / (g.gamma * src.p), 1.0 / gm1);
     const double pb = rb * cb * cb / g.gamma;
     const vec3<double> ut = axpy_n(src.u, -dot(src.u, n), n);
     return {rb, axpy_n(ut, Ub + wn, n), pb};

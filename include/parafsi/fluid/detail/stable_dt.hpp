@@ -14,9 +14,11 @@
 
 #include "../../core/error.hpp"
 #include "../../core/parallel.hpp"
+#include "../../core/simd.hpp"
 #include "../frame/pose.hpp"
 #include "../gas.hpp"
 #include "../grid.hpp"
+#include "../state.hpp"
 #include "stage.hpp"
 
 namespace parafsi::fluid::detail {
@@ -35,29 +37,45 @@ double max_wave_rate(const rectilinear_grid& grid, const gas::ideal& gas, const 
   const double* x0 = grid.centres(0);
   const double* x1 = grid.centres(1);
   const double* x2 = grid.centres(2);
+  // Packed along x (simd::for_each_pack: whole packs, then single cells; each cell's
+  // arithmetic depends on its place in the row only, not on the thread count).
   auto row_max = [&](index_t r) {
     const index_t j = r % ny, k = r / ny;
+    const double x1j = x1[j], x2k = x2[k], i1 = 1.0 / h1[j], i2 = 1.0 / h2[k];
     double lam = 0.0;
-    for (index_t i = 0; i < nx; ++i) {
-      const auto w = to_prim(load_cons(U, grid.index(i, j, k)), gas);
-      const double c = gas.sound_speed(w.rho, w.p);
-      const Eigen::Vector3d ub = Rt * Eigen::Vector3d(w.u.x, w.u.y, w.u.z);
-      const Eigen::Vector3d xi{x0[i], x1[j], x2[k]};
-      const Eigen::Vector3d wb = vh + oh.cross(xi);
-      double l = (std::fabs(ub[0] - wb[0]) + c) / h0[i] + (std::fabs(ub[1] - wb[1]) + c) / h1[j] +
-                 (std::fabs(ub[2] - wb[2]) + c) / h2[k];
-      if constexpr (Viscous) {
-        double mu_l = visc.mu(gas.temperature(w.rho, w.p));
-        double mut = 0.0;
-        if constexpr (Turbulence::active) mut = mu_t[grid.index(i, j, k)];
-        const double nu = std::max((mu_l + mut) / w.rho,
-                                   gas.gamma * (mu_l / visc.prandtl + mut / turb.prandtl_t) / w.rho);
-        const double lv = 2.0 * nu * (1.0 / (h0[i] * h0[i]) + 1.0 / (h1[j] * h1[j]) + 1.0 / (h2[k] * h2[k]));
-        // Δt_v = 0.5/lv must hold; expressed against cfl: cfl/l_eff ≤ 0.5/lv.
-        l = std::max(l, lv * cfl / 0.5);
+    simd::for_each_pack(0, nx, [&](auto tag, index_t i) {
+      using V = typename decltype(tag)::type;
+      const index_t c = grid.index(i, j, k);
+      const cons<V> q{simd::load<V>(U[0] + c),
+                      {simd::load<V>(U[1] + c), simd::load<V>(U[2] + c), simd::load<V>(U[3] + c)},
+                      simd::load<V>(U[4] + c)};
+      const prim<V> w = to_prim(q, gas);
+      const V c_s = gas.sound_speed(w.rho, w.p);
+      const V x0i = simd::load<V>(x0 + i);
+      // Box-frame velocity of the air (Rᵀu) and of the grid (V̂ + Ω̂ × ξ) at the centre.
+      V rel[3];
+      for (int d = 0; d < 3; ++d) {
+        const V ub = V(Rt(d, 0)) * w.u.x + V(Rt(d, 1)) * w.u.y + V(Rt(d, 2)) * w.u.z;
+        const int e = (d + 1) % 3, f = (d + 2) % 3;  // (Ω̂ × ξ)_d = Ω̂_e ξ_f − Ω̂_f ξ_e
+        const V xe = e == 0 ? x0i : V(e == 1 ? x1j : x2k), xf = f == 0 ? x0i : V(f == 1 ? x1j : x2k);
+        const V wb = V(vh[d]) + (V(oh[e]) * xf - V(oh[f]) * xe);
+        rel[d] = simd::abs(ub - wb) + c_s;
       }
-      lam = std::max(lam, l);
-    }
+      const V i0 = V(1.0) / simd::load<V>(h0 + i);
+      V l = rel[0] * i0 + rel[1] * V(i1) + rel[2] * V(i2);
+      if constexpr (Viscous) {
+        const V mu_l = visc.mu(gas.temperature(w.rho, w.p));
+        V mut(0.0);
+        if constexpr (Turbulence::active) mut = simd::load<V>(mu_t + c);
+        const V inv_rho = V(1.0) / w.rho;
+        const V nu = simd::max((mu_l + mut) * inv_rho,
+                               V(gas.gamma) * (mu_l * V(1.0 / visc.prandtl) + mut * V(1.0 / turb.prandtl_t)) * inv_rho);
+        const V lv = V(2.0) * nu * (i0 * i0 + V(i1 * i1 + i2 * i2));
+        // Δt_v = 0.5/lv must hold; expressed against cfl: cfl/l_eff ≤ 0.5/lv.
+        l = simd::max(l, lv * V(cfl / 0.5));
+      }
+      lam = std::max(lam, simd::hmax(l));
+    });
     return lam;
   };
   (void)visc;

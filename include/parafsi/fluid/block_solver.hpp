@@ -29,6 +29,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -401,7 +402,7 @@ class block_solver {
     return weight_.size() == blocks_.size() ? weight_ : std::vector<double>(blocks_.size(), 1.0);
   }
   /// Cut the mesh again by the blocks' measured cost (collective; a no-op without a halo).
-  /// Each process times the work of the blocks it computes (their sweeps, viscous pass,
+  /// Each process times the work of the blocks it computes (their ghost fill, sweeps, viscous pass,
   /// corrections, sources and update, the coupling faces whose high cell they hold, and
   /// what the caller adds with add_block_cost); the seconds per step since the last
   /// partition, gathered to every process, become the block weights of blocks::partition.
@@ -917,18 +918,31 @@ class block_solver {
     }
     // Each block of `ids` gets its ghosts and then, while they are in cache, its sweeps (the
     // ghosts read other blocks' interior state, which no sweep writes, so the fused order
-    // changes no bit); the ghosts' seconds are summed per thread, in thread order. Then the
-    // coarse–fine corrections.
+    // changes no bit). The loop's wall time is split between `boundaries` and `fluxes` in
+    // the ratio of the seconds the threads spent on each (summed per thread, in thread
+    // order). Then the coarse–fine corrections.
     ghost_seconds_.assign(bufs_.size(), 0.0);
+    work_seconds_.assign(bufs_.size(), 0.0);
     auto ghosts_and_sweeps = [&](const std::vector<index_t>& ids) {
-      timed(times_.fluxes, [&] {
-        for_ids(ids, [&](index_t id) {
-          costed(id, [&] {
-            timed(ghost_seconds_[std::size_t(parallel::thread_id())], [&] { fill_block_ghosts(id, t, geo); });
+      const auto start = std::chrono::steady_clock::now();
+      for_ids(ids, [&](index_t id) {
+        const std::size_t tid = std::size_t(parallel::thread_id());
+        costed(id, [&] {
+          timed(work_seconds_[tid], [&] {
+            timed(ghost_seconds_[tid], [&] { fill_block_ghosts(id, t, geo); });
             sweep_block(id, geo);
           });
         });
       });
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      double g = 0.0, w = 0.0;
+      for (std::size_t k = 0; k < ghost_seconds_.size(); ++k) {
+        g += std::exchange(ghost_seconds_[k], 0.0);
+        w += std::exchange(work_seconds_[k], 0.0);
+      }
+      const double share = w > 0.0 ? wall * (g / w) : 0.0;
+      times_.boundaries += share;
+      times_.fluxes += wall - share;
     };
     auto corrections = [&](const std::vector<index_t>& ids) {
       timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { costed(id, [&] { correct_fluxes(id); }); }); });
@@ -951,10 +965,6 @@ class block_solver {
     } else {
       ghosts_and_sweeps(local_ids_);
       corrections(correct_local_ids_);
-    }
-    for (double g : ghost_seconds_) {  // the fused ghosts' share of the fluxes' time
-      times_.boundaries += g;
-      times_.fluxes -= g;
     }
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
@@ -1604,7 +1614,7 @@ class block_solver {
   std::unique_ptr<turbulence_storage> T_;                 ///< with an eddy-viscosity closure
   std::vector<std::uint8_t> blocked_;                     ///< membrane faces' marks (one-sided patches; global_index)
   std::vector<index_t> zone_, share_block_, share_slot_;  ///< patch_zone, share_slots scratch
-  std::vector<double> ghost_seconds_;                     ///< compute_rhs: the ghosts' seconds per thread
+  std::vector<double> ghost_seconds_, work_seconds_;      ///< compute_rhs: ghosts', ghosts' + sweeps' s per thread
   std::vector<double> records_;                           ///< solve_faces: face_record::width per face
   std::vector<index_t> record_block_;                     ///< solve_faces: the block of each face's high cell
   std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves

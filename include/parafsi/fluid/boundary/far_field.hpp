@@ -23,6 +23,7 @@ struct far_field {
   double p = 101325.0;            ///< far-field pressure (Pa)
 
   static constexpr const char* name() noexcept { return "far_field"; }
+  static constexpr bool layer_invariant = true;  ///< the ghost reads the adjacent cell only
 
   fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in, const vec3<double>& n, double wn,
                             const gas::ideal& g, double) const {

@@ -10,6 +10,7 @@ struct inflow {
   vec3<double> u{0.0, 0.0, 0.0};
   double p = 101325.0;
   static constexpr const char* name() noexcept { return "inflow"; }
+  static constexpr bool layer_invariant = true;  ///< the ghost reads the adjacent cell only
   fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>&, const vec3<double>&, double,
                             const gas::ideal&, double) const {
     return {rho, u, p};

@@ -9,6 +9,7 @@ struct outflow {
   bool fix_pressure = false;
   double p_exit = 101325.0;
   static constexpr const char* name() noexcept { return "outflow"; }
+  static constexpr bool layer_invariant = true;  ///< the ghost reads the adjacent cell only
   fluid::prim<double> ghost(const fluid::prim<double>&, const fluid::prim<double>& in, const vec3<double>&, double,
                             const gas::ideal&, double) const {
     fluid::prim<double> g = in;

@@ -183,6 +183,11 @@ int main(int argc, char** argv) {
   app.add_option("--refine-every", c.refine_every, "blocks: regrid to the canopy every this many steps")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
+  app.add_option("--root-blocks", c.root_blocks,
+                 "blocks: the least number of root blocks across the box's narrowest side (sets the levels: "
+                 "1 gives blocks of 16 the levels of blocks of 8)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   app.add_flag("--refine-column", c.refine_column,
                "blocks: also hold the finest level on the tensor box's refined column about the axis (from below "
                "the line confluence to above the crown)");

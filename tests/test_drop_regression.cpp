@@ -259,6 +259,13 @@ TEST_CASE("drop config: silently dropped settings are refused by name") {
   c = cfg{};
   c.grid_offset = 1.0;
   refused(c, "the grid offset must be in [0, 1) cells, got 1");
+  c = cfg{};
+  c.mesh = "blocks";
+  c.root_blocks = 0;
+  refused(c, "--root-blocks must be in [1, 16], got 0");
+  c.root_blocks = 2;
+  c.refine_every = 0;
+  refused(c, "--refine-every must be >= 1 step, got 0");
 }
 
 // Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the

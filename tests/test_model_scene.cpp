@@ -15,6 +15,7 @@
 #include <parafsi/model/drop_box.hpp>
 #include <parafsi/model/drop_scene.hpp>
 #include <parafsi/model/duct_screen.hpp>
+#include <parafsi/scene/drop_steps.hpp>
 
 namespace pf = parafsi;
 namespace md = parafsi::model;
@@ -423,6 +424,36 @@ TEST_CASE("drop box: extents, refined block, axes and size from the scene") {
   CHECK(q.axes.determinant() == doctest::Approx(1.0).epsilon(1e-14));
   CHECK((q.axes.col(2) - sq.axis()).norm() < 1e-14);
   CHECK((q.axes.col(1) - Eigen::Vector3d::UnitY()).norm() < 1e-14);
+}
+
+TEST_CASE("drop box as blocks: the finest cell is h, the root blocks cover the box, levels from the block size") {
+  auto P = md::drop_scene_parameters::paper();
+  const auto R = md::drop_resolution::preset("coarse");
+  P.canopy.element_size = R.element * P.canopy.nominal_diameter;
+  const auto s = md::build_drop_scene(P);
+  md::drop_box_parameters bp;  // 5 x 5 x 7 D0
+  bp.cell = R.cell;
+  const md::drop_box b = md::make_drop_box(s, bp);
+  // L the largest with `across` root blocks of n 2^L h within the narrowest side (5 m):
+  // 5 / (2 * 8 * 0.0667) = 4.69 -> L = 2; 5 / (1 * 16 * 0.0667) = 4.69 -> L = 2 too.
+  auto check = [&](int n, int across, int L_expected, index_t nb_xy) {
+    const auto [lay, L] = pf::scene::make_drop_blocks(b, n, across);
+    CHECK(L == L_expected);
+    CHECK(lay.block_cells == n);
+    for (int d = 0; d < 3; ++d) {
+      CHECK(lay.cell_width(d, L) == doctest::Approx(b.cell).epsilon(1e-12));
+      CHECK(lay.lo[std::size_t(d)] <= b.lo[std::size_t(d)] + 1e-12);  // the box, grown to whole root blocks
+      CHECK(lay.hi[std::size_t(d)] >= b.hi[std::size_t(d)] - 1e-12);
+      CHECK(0.5 * (lay.lo[std::size_t(d)] + lay.hi[std::size_t(d)]) ==
+            doctest::Approx(0.5 * (b.lo[std::size_t(d)] + b.hi[std::size_t(d)])).epsilon(1e-12));
+    }
+    CHECK(lay.root_blocks[0] == nb_xy);
+    CHECK(lay.root_blocks[1] == nb_xy);
+  };
+  check(8, 2, 2, 3);   // root blocks of 2.13 m: 3 across 5 m
+  check(16, 2, 1, 3);  // the same root width with one level less
+  check(16, 1, 2, 2);  // root blocks of 4.27 m: 2 across, the levels of the 8-cell blocks
+  CHECK_THROWS_WITH_AS(pf::scene::make_drop_blocks(b, 8, 0), doctest::Contains("across >= 1"), pf::invalid_input);
 }
 
 TEST_CASE("drop box and canopy: sizes that would overflow a count or the memory are refused first") {

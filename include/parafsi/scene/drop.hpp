@@ -101,7 +101,8 @@ struct drop_config {
   std::string coupling = "embedded";  ///< embedded | penalty
   std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh
   int block_size = 8;                 ///< blocks: cells per block edge
-  int refine_every = 5;               ///< blocks: regrid to the canopy every this many steps
+  int refine_every = 1;               ///< blocks: regrid to the canopy every this many steps
+  int root_blocks = 2;                ///< blocks: the least number of root blocks across the box's narrowest side
   /// blocks: also refine the wake where |ω| h > this × the payload's speed (the velocity
   /// turning by that fraction across a cell; coarsened below a quarter of it); 0 = off
   double refine_vorticity = 0;
@@ -189,6 +190,8 @@ struct drop_config {
       require(block_size >= 4 && block_size <= 64 && block_size % 2 == 0,
               "parachute_drop: --block-size must be even and in [4, 64], got ", block_size);
       require(refine_every >= 1, "parachute_drop: --refine-every must be >= 1 step, got ", refine_every);
+      require(root_blocks >= 1 && root_blocks <= 16, "parachute_drop: --root-blocks must be in [1, 16], got ",
+              root_blocks);
       require(std::isfinite(refine_vorticity) && refine_vorticity >= 0 && refine_vorticity <= 10,
               "parachute_drop: --refine-vorticity must be in [0, 10] (0: off), got ", refine_vorticity);
     } else {
@@ -385,6 +388,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
         .add("refine_every", std::int64_t(c.refine_every))
         .add("refine_vorticity", c.refine_vorticity)
         .add("refine_column", std::int64_t(c.refine_column));
+  if (c.mesh == "blocks" && c.root_blocks != 2) g.add("root_blocks", std::int64_t(c.root_blocks));
   return g;
 }
 
@@ -850,7 +854,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
     const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
     if (c.mesh == "blocks") {
       // The block mesh: one level to start with, refined to the canopy before the first step.
-      const auto [lay, levels] = make_drop_blocks(su.box, c.block_size);
+      const auto [lay, levels] = make_drop_blocks(su.box, c.block_size, c.root_blocks);
       fluid::block_solver fl{fluid::blocks::tree(lay.root_blocks), lay,  bc,      flux::hllc_lm{},
                              recon::muscl<limiter::van_leer>{},    visc, closure, frame};
       fl.fill_uniform(air);

@@ -3,7 +3,7 @@
 /// (examples/drop_guide.cpp) shares with scene::run_drop (scene/drop.hpp):
 ///
 ///   make_drop_grid(box)               the rectilinear grid of a model::drop_box
-///   make_drop_blocks(box, n)          its block-mesh layout and finest level (--mesh blocks)
+///   make_drop_blocks(box, n, across)  its block-mesh layout and finest level (--mesh blocks)
 ///   drop_block_target(...)            the block mesh's refinement target: the canopy
 ///   place_drop_box(fluid, box, chute) the box pose: axes, payload mass centre, velocity
 ///   drop_frame_target<Fluid>(g)       the stepper's frame target: the payload's mass centre
@@ -40,14 +40,16 @@ inline fluid::rectilinear_grid make_drop_grid(const model::drop_box& b) {
 
 /// The block mesh of the box `b` with n cells per block edge: the finest cell is the box's
 /// refined cell h, and L levels above the root grid with L the largest that leaves at least
-/// two root blocks (n 2^L h wide) across the narrowest side; the root blocks tile a box
-/// grown about the same centre to whole blocks (every axis keeps cubic cells). Returns the
-/// layout and L.
-inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_box& b, int n) {
+/// `across` root blocks (n 2^L h wide) across the narrowest side (2 by default; 1 gives blocks
+/// of 16³ the levels of 8³ blocks across the same box); the root blocks tile a box grown
+/// about the same centre to whole blocks (every axis keeps cubic cells). Returns the layout
+/// and L.
+inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_box& b, int n, int across = 2) {
+  require(n >= 2 && across >= 1, "scene::make_drop_blocks: need n >= 2 and across >= 1, got ", n, " and ", across);
   const double h = b.cell;
   double narrow = 1e300;
   for (std::size_t d = 0; d < 3; ++d) narrow = std::min(narrow, b.hi[d] - b.lo[d]);
-  const int L = std::max(0, int(std::floor(std::log2(narrow / (2.0 * n * h)))));
+  const int L = std::max(0, int(std::floor(std::log2(narrow / (double(across) * n * h)))));
   require(L <= fluid::blocks::tree::max_depth, "scene::make_drop_blocks: ", L, " levels are too many");
   const double root = double(n) * h * std::ldexp(1.0, L);
   fluid::block_layout lay;

@@ -510,3 +510,45 @@ TEST_CASE("refinement near a structure: every structure point and its buffer lie
   CHECK(double(s.cell_count()) < 0.05 * uniform);
   CHECK_THROWS_WITH_AS(fb::near_points(lay, pts, -1.0, 3), doctest::Contains("buffer"), invalid_input);
 }
+
+TEST_CASE("graded refinement criterion: the binned, bounding-box-pruned query equals testing every point") {
+  // Points on a tilted ring and a line (a skirt and a riser) in a 5 x 5 x 7 m box of
+  // 2 x 2 x 3 root blocks; every location of levels 0-4 asked, against the brute force:
+  // level L within buffer, level l < L within buffer 2^(L - l), else 0.
+  fluid::block_layout lay{{-2.5, -2.5, -3.5}, {2.5, 2.5, 3.5}, {2, 2, 3}, 8};
+  std::vector<Eigen::Vector3d> pts;
+  for (int a = 0; a < 300; ++a) {
+    const double ph = 2 * M_PI * a / 300;
+    pts.emplace_back(0.4 * std::cos(ph) + 0.21, 0.35 * std::sin(ph) - 0.13, 0.6 + 0.2 * std::cos(ph));
+  }
+  for (int a = 0; a < 50; ++a) pts.emplace_back(0.21, -0.13, 0.6 - 0.03 * a);
+  const double buffer = 0.07;
+  const int top = 4;
+  fb::near_points crit(lay, pts, buffer, top, /*graded=*/true);
+  auto brute = [&](const fb::location& q) {
+    const fb::block_box b = fb::box_of(lay, q);
+    double dmin = HUGE_VAL;
+    for (const auto& p : pts) dmin = std::min(dmin, fb::distance(b, p));
+    if (dmin <= buffer) return top;
+    for (int l = top - 1; l >= 1; --l)
+      if (dmin <= std::ldexp(buffer, top - l)) return l;
+    return 0;
+  };
+  int asked = 0, differ = 0, at[top + 1] = {};
+  for (int L = 0; L <= top; ++L) {
+    const std::int64_t nx = std::int64_t(2) << L, ny = nx, nz = std::int64_t(3) << L;
+    for (std::int64_t k = 0; k < nz; ++k)
+      for (std::int64_t j = 0; j < ny; ++j)
+        for (std::int64_t i = 0; i < nx; ++i) {
+          const fb::location q{L, {i, j, k}};
+          const int want = brute(q);
+          differ += crit(q) != want;
+          ++at[want];
+          ++asked;
+        }
+  }
+  MESSAGE(asked, " locations; targets 0..4: ", at[0], " ", at[1], " ", at[2], " ", at[3], " ", at[4]);
+  CHECK(differ == 0);
+  for (int l = 0; l <= top; ++l) CHECK(at[l] > 0);  // every branch of the criterion met
+  CHECK(fb::near_points(lay, std::vector<Eigen::Vector3d>{}, buffer, top, true)({2, {1, 1, 1}}) == 0);
+}

@@ -7,7 +7,7 @@
 /// levels (the membranes sit on the finest level, which sets the step anyway); every
 /// Runge–Kutta stage is the recipe
 ///   exchange face ghosts (copy · restrict · prolong, blocks/exchange.hpp; with a viscosity
-///   policy edges and corners too) → boundary ghosts → primitives where the kernels read
+///   policy the edge ghosts one cell deep too) → boundary ghosts → primitives where the kernels read
 ///   them → three flux sweeps per block, keeping boundary-face fluxes → viscous pass (with
 ///   a viscosity policy; its boundary-face fluxes join the kept ones) → coarse–fine flux
 ///   correction (blocks/flux_correction.hpp) → the coupling's face patches → sources and
@@ -40,6 +40,7 @@
 #include <string>
 #include <tuple>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -638,7 +639,14 @@ class block_solver {
             "fluid::block_solver::regrid: max_level must be "
             "in [0, ",
             blocks::tree::max_depth, "], got ", max_level);
-    auto want = [&](const blocks::location& q) { return std::min(max_level, int(target(q))); };
+    // Each location's target once (the merge passes ask again for the leaves the refine
+    // pass asked about).
+    std::unordered_map<std::uint64_t, int> targets;
+    auto want = [&](const blocks::location& q) {
+      const auto [it, fresh] = targets.try_emplace(blocks::tree::key(q), 0);
+      if (fresh) it->second = std::min(max_level, int(target(q)));
+      return it->second;
+    };
     blocks::tree next = tree_;
     next.refine_where(max_level, [&](const blocks::location& q) { return want(q) > q.level; });
     for (bool merged = true; merged;) {
@@ -726,6 +734,13 @@ class block_solver {
     const index_t total = stride_ * index_t(nleaf);
     U_ = std::make_unique<cons_storage>(total, 0.0);
     U0_ = std::make_unique<cons_storage>(total, 0.0);
+    // Cells that no exchange, boundary or transfer writes (corner ghosts, the outer edge
+    // ghosts) hold a gas at rest (ρ = 1, p = (γ − 1)·1): the primitives and the viscous pass
+    // compute on every cell of a block, and only finite values there are harmless.
+    for (auto* u : {U_.get(), U0_.get()}) {
+      std::fill_n(u->template get<field::rho>(), total, 1.0);
+      std::fill_n(u->template get<field::E>(), total, 1.0);
+    }
     dU_ = std::make_unique<cons_storage>(total, 0.0);
     W_ = std::make_unique<prim_storage>(total, 1.0);
     S_.reset();
@@ -1429,7 +1444,8 @@ class block_solver {
     blocks::execute_plan(plan_[std::size_t(id)], id, U_all_, n_, gas_);
     block& b = blocks_[std::size_t(id)];
     if (b.boundary != std::array<bool, 6>{})
-      detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous);
+      detail::fill_ghosts(b.grid, bc_, gas_, geo, t, detail::conserved_ptrs(b.U), false, b.boundary, is_viscous,
+                          /*edge_depth=*/1);
   }
 
   /// Move the state of the old leaves onto the new ones (regrid).

@@ -13,7 +13,10 @@
 ///     until the next regrid.
 ///
 /// Points are binned on a uniform grid of bins one buffer-plus-block wide, so a query
-/// looks at the few bins the block's box (grown by the buffer) overlaps.
+/// looks at the few bins the block's box (grown by the buffer) overlaps. A query first
+/// tests the points' bounding box and each bin's, so a block far from every point (most
+/// of a drop's box) is answered without a distance, and a bin beyond the radius without
+/// its points (the answers are those of testing every point).
 ///
 ///   leaf_indicator{tree, values, refine_above, coarsen_below, max_level}: a flow criterion
 ///     from one value per leaf of the current tree (e.g. block_solver::vorticity_indicator,
@@ -76,7 +79,12 @@ class near_points {
     // Bins as wide as the buffer plus a root block's width / 2^level (≥ one finest block).
     for (int d = 0; d < 3; ++d) bin_ = std::max(bin_, lay.block_width(d, level));
     bin_ = std::max(bin_ + buffer_, 1e-12);
-    for (std::size_t i = 0; i < pts_.size(); ++i) bins_[key(bin_of(pts_[i]))].push_back(i);
+    for (std::size_t i = 0; i < pts_.size(); ++i) {
+      bin& bn = bins_[key(bin_of(pts_[i]))];
+      bn.points.push_back(i);
+      grow(bn.bounds, pts_[i]);
+      grow(all_, pts_[i]);
+    }
   }
 
   int operator()(const location& q) const {
@@ -90,6 +98,7 @@ class near_points {
 
   /// Whether some point lies within distance r of the box.
   bool near(const block_box& b, double r) const {
+    if (pts_.empty() || gap(b, all_) > r) return false;
     std::array<std::int64_t, 3> a{}, z{};
     for (int d = 0; d < 3; ++d) {
       a[std::size_t(d)] = std::int64_t(std::floor((b.lo[std::size_t(d)] - r) / bin_));
@@ -99,8 +108,8 @@ class near_points {
       for (std::int64_t j = a[1]; j <= z[1]; ++j)
         for (std::int64_t i = a[0]; i <= z[0]; ++i) {
           const auto it = bins_.find(key({i, j, k}));
-          if (it == bins_.end()) continue;
-          for (std::size_t p : it->second)
+          if (it == bins_.end() || gap(b, it->second.bounds) > r) continue;
+          for (std::size_t p : it->second.points)
             if (distance(b, pts_[p]) <= r) return true;
         }
     return false;
@@ -117,13 +126,37 @@ class near_points {
            std::uint64_t(c[2]) * 0x165667B19E3779F9ull;
   }
 
+  /// The points of a bin and their bounding box.
+  struct bin {
+    std::vector<std::size_t> points;
+    block_box bounds{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+  };
+  static void grow(block_box& bb, const Eigen::Vector3d& p) {
+    for (int d = 0; d < 3; ++d) {
+      bb.lo[std::size_t(d)] = std::min(bb.lo[std::size_t(d)], p[d]);
+      bb.hi[std::size_t(d)] = std::max(bb.hi[std::size_t(d)], p[d]);
+    }
+  }
+  /// A lower bound of the distance from box b to any point inside box o: the gap between
+  /// the two boxes (0 where they overlap), never more than a point's distance(b, p).
+  static double gap(const block_box& b, const block_box& o) {
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const std::size_t u = std::size_t(d);
+      const double e = std::max({o.lo[u] - b.hi[u], 0.0, b.lo[u] - o.hi[u]});
+      d2 += e * e;
+    }
+    return std::sqrt(d2);
+  }
+
   Layout lay_;
   std::vector<Eigen::Vector3d> pts_;
   double buffer_;
   int level_;
   bool graded_;
   double bin_ = 0;
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> bins_;
+  std::unordered_map<std::uint64_t, bin> bins_;
+  block_box all_{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
 };
 
 /// A flow criterion from one value per leaf of the current tree (see the file comment).

@@ -197,12 +197,13 @@ class tree {
     return m;
   }
 
- private:
+  /// A location's key (level and coordinates; unique below max_depth and max_root).
   static std::uint64_t key(const location& q) noexcept {
     return (std::uint64_t(q.level) << 59) | (std::uint64_t(q.l[2]) << 38) | (std::uint64_t(q.l[1]) << 19) |
            std::uint64_t(q.l[0]);
   }
 
+ private:
   /// Split q after splitting every coarser touching leaf (recursively); returns splits.
   index_t split_balanced(const location& q) {
     index_t splits = 0;

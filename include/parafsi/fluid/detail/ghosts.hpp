@@ -8,7 +8,8 @@
 /// On a block mesh a block fills only its faces on the box boundary (`fill`), and only
 /// their face slabs (`edges` false: interior transverse ranges; the blocks' exchange,
 /// blocks/exchange.hpp, leaves edge and corner ghosts too, as only the viscous pass reads
-/// them, and with it the block solver passes `edges` true).
+/// them, and with it the block solver passes `edges` true and `edge_depth` 1: the edge
+/// ghosts one cell deep on both axes, which is all the viscous pass's fluxes read).
 #pragma once
 #include <array>
 #include <type_traits>
@@ -34,7 +35,8 @@ inline constexpr bool layer_invariant = requires {
 
 inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, const gas::ideal& gas,
                         const stage_geometry& geo, double t, const fields5<double>& U, bool threaded,
-                        const std::array<bool, 6>& fill = all_faces, bool edges = true) {
+                        const std::array<bool, 6>& fill = all_faces, bool edges = true,
+                        index_t edge_depth = rectilinear_grid::ghosts) {
   constexpr index_t ng = rectilinear_grid::ghosts;
   const index_t n[3] = {grid.n(0), grid.n(1), grid.n(2)};
   for (int d = 0; d < 3; ++d) {
@@ -44,7 +46,7 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
     auto range = [&](int axis) -> std::pair<index_t, index_t> {
       const bool lo = edges && (axis < d || !fill[std::size_t(2 * axis)]),
                  hi = edges && (axis < d || !fill[std::size_t(2 * axis + 1)]);
-      return {lo ? -ng : 0, hi ? n[axis] + ng : n[axis]};
+      return {lo ? -edge_depth : 0, hi ? n[axis] + edge_depth : n[axis]};
     };
     const auto ra = range(a), rb = range(b);
     for (int hi = 0; hi < 2; ++hi) {
@@ -54,19 +56,25 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
       std::visit(
           [&](const auto& cond) {
         using C = std::decay_t<decltype(cond)>;
+        // The boundary (adjacent) interior cell at transverse (pidx, q), written to ijk: its
+        // primitives and the grid's outward normal speed at its boundary face centre.
+        [[maybe_unused]] auto adjacent = [&](index_t pidx, index_t q, index_t(&ijk)[3]) {
+          ijk[a] = pidx;
+          ijk[b] = q;
+          ijk[d] = hi ? n[d] - 1 : 0;
+          const auto wa = to_prim(load_cons(U, grid.index(ijk[0], ijk[1], ijk[2])), gas);
+          Eigen::Vector3d xi{grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
+          xi[d] = hi ? grid.face(d, n[d]) : grid.face(d, 0);
+          const double wn = (hi ? 1.0 : -1.0) * (geo.vh[d] + geo.oh.cross(xi)[d]);
+          return std::pair{wa, wn};
+        };
         par_for(threaded, rb.first, rb.second, [&](index_t q) {
           for (index_t pidx = ra.first; pidx < ra.second; ++pidx) {
             // A condition whose ghost depends on the adjacent cell only (no mirror): computed
             // once for the face and stored in every ghost layer.
             if constexpr (layer_invariant<C>) {
               index_t ijk[3];
-              ijk[a] = pidx;
-              ijk[b] = q;
-              ijk[d] = hi ? n[d] - 1 : 0;  // boundary (adjacent) interior cell
-              const auto wa = to_prim(load_cons(U, grid.index(ijk[0], ijk[1], ijk[2])), gas);
-              Eigen::Vector3d xi{grid.centre(0, ijk[0]), grid.centre(1, ijk[1]), grid.centre(2, ijk[2])};
-              xi[d] = hi ? grid.face(d, n[d]) : grid.face(d, 0);
-              const double wn = (hi ? 1.0 : -1.0) * (geo.vh[d] + geo.oh.cross(xi)[d]);
+              const auto [wa, wn] = adjacent(pidx, q, ijk);
               const auto qg = to_cons(cond.ghost(wa, wa, nout, wn, gas, t), gas);
               for (index_t g = 1; g <= ng; ++g) {
                 ijk[d] = hi ? n[d] - 1 + g : -g;
@@ -74,9 +82,9 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
               }
             } else {
               for (index_t g = 1; g <= ng; ++g) {
-                index_t ijk_g[3], ijk_m[3], ijk_a[3];
-                ijk_g[a] = ijk_m[a] = ijk_a[a] = pidx;
-                ijk_g[b] = ijk_m[b] = ijk_a[b] = q;
+                index_t ijk_g[3], ijk_m[3];
+                ijk_g[a] = ijk_m[a] = pidx;
+                ijk_g[b] = ijk_m[b] = q;
                 ijk_g[d] = hi ? n[d] - 1 + g : -g;
                 if constexpr (std::is_same_v<C, boundary::periodic>) {
                   ijk_m[d] = hi ? g - 1 : n[d] - g;
@@ -85,14 +93,10 @@ inline void fill_ghosts(const rectilinear_grid& grid, const boundary::set& bcs, 
                   store_cons(U, cg, load_cons(U, cm));
                 } else {
                   ijk_m[d] = hi ? n[d] - g : g - 1;  // mirror image of the ghost
-                  ijk_a[d] = hi ? n[d] - 1 : 0;      // boundary (adjacent) interior cell
                   const index_t cg = grid.index(ijk_g[0], ijk_g[1], ijk_g[2]);
                   const auto wm = to_prim(load_cons(U, grid.index(ijk_m[0], ijk_m[1], ijk_m[2])), gas);
-                  const auto wa = to_prim(load_cons(U, grid.index(ijk_a[0], ijk_a[1], ijk_a[2])), gas);
-                  // Grid normal speed at the boundary face centre (outward normal).
-                  Eigen::Vector3d xi{grid.centre(0, ijk_a[0]), grid.centre(1, ijk_a[1]), grid.centre(2, ijk_a[2])};
-                  xi[d] = hi ? grid.face(d, n[d]) : grid.face(d, 0);
-                  const double wn = (hi ? 1.0 : -1.0) * (geo.vh[d] + geo.oh.cross(xi)[d]);
+                  index_t ijk_a[3];
+                  const auto [wa, wn] = adjacent(pidx, q, ijk_a);
                   store_cons(U, cg, to_cons(cond.ghost(wm, wa, nout, wn, gas, t), gas));
                 }
               }

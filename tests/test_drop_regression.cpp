@@ -224,6 +224,54 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
   fs::remove_all(base);
 }
 
+// The block mesh's parameters are part of the signature too: a tiny block-mesh run's
+// checkpoint refuses a restart with another block size, regrid interval, refinement or
+// number of root blocks (root_blocks enters only when it is not the default 2, as
+// grid_offset does when it is not 0), and one on the tensor box.
+TEST_CASE("drop restart on blocks: a changed block-mesh parameter is refused by name") {
+  namespace fs = std::filesystem;
+  parafsi::parallel::set_threads(1);
+  const fs::path base = fs::temp_directory_path() / "parafsi_drop_signature_blocks";
+  fs::remove_all(base);
+  parafsi::scene::drop_config c0;
+  c0.resolution = "tiny";
+  c0.mesh = "blocks";
+  c0.t_end = 0.01;
+  c0.initial_speed = 8.0;
+  c0.quiet = true;
+  c0.out = base.string();
+  c0.checkpoint_every = 0.01;
+  parafsi::scene::run_drop(c0);
+  REQUIRE(fs::exists(base / "checkpoint.ckpt"));
+  c0.out.clear();
+  c0.checkpoint_every = 0;
+  c0.restart = (base / "checkpoint.ckpt").string();
+  c0.t_end = 0.015;
+  using cfg = parafsi::scene::drop_config;
+  struct change {
+    const char* name;
+    void (*apply)(cfg&);
+  };
+  const change changes[] = {
+      {"block_size", [](cfg& c) { c.block_size = 4; }},
+      {"refine_every", [](cfg& c) { c.refine_every = 3; }},
+      {"refine_vorticity", [](cfg& c) { c.refine_vorticity = 0.2; }},
+      {"refine_column", [](cfg& c) { c.refine_column = true; }},
+      {"root_blocks", [](cfg& c) { c.root_blocks = 1; }},
+      {"mesh", [](cfg& c) { c.mesh = "tensor"; }},
+  };
+  for (const change& ch : changes) {
+    CAPTURE(ch.name);
+    cfg c = c0;
+    ch.apply(c);
+    const std::string expected = std::string("scene parameter '") + ch.name + "' is ";
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected.c_str()), parafsi::invalid_input);
+  }
+  const auto r = parafsi::scene::run_drop(c0);  // the same scene restarts
+  CHECK(r.history.size() == 4);
+  fs::remove_all(base);
+}
+
 // Settings that would be dropped silently are refused before anything is built, naming
 // the flag: output intervals without an output directory, a reduced radius of 0, a bundle
 // mouth outside [0.01, 0.5] D0, slice

@@ -253,6 +253,26 @@ TEST_CASE("block mesh: results do not depend on the thread count (bitwise)") {
   CHECK(rho[0] == rho[1]);
 }
 
+// A cell that is not a gas (here a NaN density) stops the step choice with a message, on
+// the block mesh and on the box, instead of a maximum over the cells that skips it (one
+// cell of the 512, inside a pack and not its first lane).
+TEST_CASE("stable_dt: a NaN cell stops the run with a message instead of being skipped") {
+  const boundary::set bc = boundary::set::all(boundary::far_field{1.18, {0, 0, 0}, 101325.0});
+  auto [blk, box] = twin({1, 1, 1}, 8, {0, 0, 0}, {1, 1, 1}, bc, {false, false, false});
+  auto still = [](const Eigen::Vector3d&) { return prim{1.18, {3, 0, 0}, 101325.0}; };
+  blk.initialize(still);
+  box.initialize(still);
+  const double dt = blk.stable_dt(0.5);
+  CHECK(dt == doctest::Approx(box.stable_dt(0.5)).epsilon(1e-14));
+  CHECK(dt == doctest::Approx(0.5 / (3 * (std::sqrt(1.4 * 101325.0 / 1.18)) / 0.125 + 3 / 0.125)).epsilon(1e-12));
+  blk.for_each_cell([&](auto& b, index_t i, index_t j, index_t k) {
+    if (i == 3 && j == 2 && k == 5) b.U.template get<fluid::field::rho>()[b.grid.index(i, j, k)] = std::nan("");
+  });
+  box.conserved_storage().template get<fluid::field::rho>()[box.grid().index(3, 2, 5)] = std::nan("");
+  CHECK_THROWS_WITH_AS(blk.stable_dt(0.5), doctest::Contains("non-finite wave speed"), invalid_input);
+  CHECK_THROWS_WITH_AS(box.stable_dt(0.5), doctest::Contains("non-finite wave speed"), invalid_input);
+}
+
 TEST_CASE("an acoustic pulse crossing into finer blocks reflects < 1 % of its energy") {
   // A right-running Gaussian pulse (p' = 1e-3 p0, u' = p'/(rho c), rho' = p'/c^2) crosses
   // x = 1, beyond which the blocks are one level finer; the energy left behind in x < 0.95

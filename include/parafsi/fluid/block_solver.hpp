@@ -461,7 +461,9 @@ class block_solver {
     double lam = 0.0;
     for (index_t id : computed_) lam = std::max(lam, rate_[std::size_t(id)]);
     if (halo_) lam = halo_->max(lam);  // exact: every process takes the same step
-    require(std::isfinite(lam) && lam > 0.0, "fluid::block_solver::stable_dt: non-finite wave speed");
+    require(std::isfinite(lam) && lam > 0.0,
+            "fluid::block_solver::stable_dt: non-finite wave speed (a cell's state is NaN or infinite, or its pressure "
+            "and density differ in sign)");
     return cfl / lam;
   }
 
@@ -1431,9 +1433,9 @@ class block_solver {
     if (!H.bf.hi && !A.bf.hi) move(detail::neighbour_face_change<D>(geo, H, A), H, hc.global, A, above.global);
   }
 
-  /// Every block's face ghosts from neighbours, then the box's boundary conditions; edge
-  /// and corner ghosts only for the viscous pass (its cell gradients on the ghost ring read
-  /// them), which the inviscid kernels never read.
+  /// Every block's face ghosts from neighbours, then the box's boundary conditions; the
+  /// edge ghosts one cell deep only for the viscous pass (its tangential differences on the
+  /// first ghost layer read them), which the inviscid kernels never read; corners never.
   void fill_ghosts_all(double t, index_t first, index_t last) {
     const auto geo = detail::geometry(pose_);
     detail::par_for(threaded_, first, last, [&](index_t id) { fill_block_ghosts(id, t, geo); });

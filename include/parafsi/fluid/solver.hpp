@@ -299,7 +299,9 @@ class solver {
     if constexpr (has_eddy_viscosity) mu_t = turb_store_.template get<field::mu_t>();
     const double lam = detail::max_wave_rate<is_viscous>(grid_, gas_, pose_, detail::conserved_ptrs(U_), visc_, turb_,
                                                          mu_t, cfl, rate_slots_, threaded_);
-    require(std::isfinite(lam) && lam > 0.0, "fluid::solver::stable_dt: non-finite wave speed");
+    require(std::isfinite(lam) && lam > 0.0,
+            "fluid::solver::stable_dt: non-finite wave speed (a cell's state is NaN or infinite, or its pressure "
+            "and density differ in sign)");
     return cfl / lam;
   }
 

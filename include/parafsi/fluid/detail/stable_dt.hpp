@@ -4,7 +4,9 @@
 ///   λ ← max(λ, lv CFL/0.5),  lv = 2 ν_eff Σ_d 1/h_d²,                   (viscous: Δt_v = 0.5/lv)
 ///   ν_eff = max(μ_eff/ρ, γ (μ/Pr + μ_t/Pr_t)/ρ),
 /// ŵ the grid velocity at the cell centre (box components). The maximum is reduced per
-/// row in a fixed order (thread-count independent) into caller-owned slots.
+/// row in a fixed order (thread-count independent) into caller-owned slots. A cell whose
+/// rate is not finite (a state that is not a gas: NaN, infinite) makes its row's rate +∞,
+/// so the caller's check stops the run there instead of a maximum that skips the NaN.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -63,6 +65,8 @@ double max_wave_rate(const rectilinear_grid& grid, const gas::ideal& gas, const 
       }
       const V i0 = V(1.0) / simd::load<V>(h0 + i);
       V l = rel[0] * i0 + rel[1] * V(i1) + rel[2] * V(i2);
+      // Checked before the viscous limit: simd::max(NaN, x) would return x.
+      if (!simd::all_finite(l)) lam = HUGE_VAL;
       if constexpr (Viscous) {
         const V mu_l = visc.mu(gas.temperature(w.rho, w.p));
         V mut(0.0);

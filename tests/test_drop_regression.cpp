@@ -148,31 +148,53 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
   fs::remove_all(base);
 }
 
-// A restart refuses every parameter that changes the run (scene::drop_signature), naming
-// it: one checkpoint at 0.01 s of a tiny run, then a restart per changed parameter.
-TEST_CASE("drop restart: a changed scene parameter is refused by name") {
-  namespace fs = std::filesystem;
+// A tiny run of `mesh` checkpointed at 0.01 s into `base`, and the configuration that
+// restarts from that checkpoint to 0.015 s (same scene).
+parafsi::scene::drop_config checkpointed(const std::filesystem::path& base, const std::string& mesh) {
   parafsi::parallel::set_threads(1);
-  const fs::path base = fs::temp_directory_path() / "parafsi_drop_signature";
-  fs::remove_all(base);
+  std::filesystem::remove_all(base);
   parafsi::scene::drop_config c0;
   c0.resolution = "tiny";
+  c0.mesh = mesh;
   c0.t_end = 0.01;
   c0.initial_speed = 8.0;
   c0.quiet = true;
   c0.out = base.string();
   c0.checkpoint_every = 0.01;
   parafsi::scene::run_drop(c0);
-  REQUIRE(fs::exists(base / "checkpoint.ckpt"));
+  REQUIRE(std::filesystem::exists(base / "checkpoint.ckpt"));
   c0.out.clear();
   c0.checkpoint_every = 0;
   c0.restart = (base / "checkpoint.ckpt").string();
-  c0.t_end = 0.02;
+  c0.t_end = 0.015;
+  return c0;
+}
+
+/// A scene parameter and how to change it.
+struct signature_change {
+  const char* name;
+  void (*apply)(parafsi::scene::drop_config&);
+};
+
+// Each change refuses the restart of c0, naming its parameter.
+template <std::size_t N>
+void refused_by_name(const parafsi::scene::drop_config& c0, const signature_change (&changes)[N]) {
+  for (const signature_change& ch : changes) {
+    CAPTURE(ch.name);
+    parafsi::scene::drop_config c = c0;
+    ch.apply(c);
+    const std::string expected = std::string("scene parameter '") + ch.name + "' is ";
+    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected.c_str()), parafsi::invalid_input);
+  }
+}
+
+// A restart refuses every parameter that changes the run (scene::drop_signature), naming
+// it: one checkpoint at 0.01 s of a tiny run, then a restart per changed parameter.
+TEST_CASE("drop restart: a changed scene parameter is refused by name") {
+  const std::filesystem::path base = std::filesystem::temp_directory_path() / "parafsi_drop_signature";
+  const parafsi::scene::drop_config c0 = checkpointed(base, "tensor");
   using cfg = parafsi::scene::drop_config;
-  struct change {
-    const char* name;
-    void (*apply)(cfg&);
-  };
+  using change = signature_change;
   const change changes[] =
       {
           {"canopy", [](cfg& c) { c.canopy = "c9"; }},
@@ -208,20 +230,12 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
           {"box_length", [](cfg& c) { c.box_length = 8; }},
           {"box_ahead", [](cfg& c) { c.box_ahead = 2; }},
   };
-  for (const change& ch : changes) {
-    CAPTURE(ch.name);
-    cfg c = c0;
-    ch.apply(c);
-    const std::string expected = std::string("scene parameter '") + ch.name + "' is ";
-    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected.c_str()), parafsi::invalid_input);
-  }
+  refused_by_name(c0, changes);
   // The same scene restarts (t_end, out and the output intervals are not part of it).
-  cfg same = c0;
-  same.t_end = 0.015;
-  const auto r = parafsi::scene::run_drop(same);
+  const auto r = parafsi::scene::run_drop(c0);
   CHECK(r.history.size() == 4);  // 0, 0.005, 0.01 carried; 0.015
   CHECK(r.history[2].t == doctest::Approx(0.01).epsilon(1e-12));
-  fs::remove_all(base);
+  std::filesystem::remove_all(base);
 }
 
 // The block mesh's parameters are part of the signature too: a tiny block-mesh run's
@@ -229,29 +243,10 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
 // number of root blocks (root_blocks enters only when it is not the default 2, as
 // grid_offset does when it is not 0), and one on the tensor box.
 TEST_CASE("drop restart on blocks: a changed block-mesh parameter is refused by name") {
-  namespace fs = std::filesystem;
-  parafsi::parallel::set_threads(1);
-  const fs::path base = fs::temp_directory_path() / "parafsi_drop_signature_blocks";
-  fs::remove_all(base);
-  parafsi::scene::drop_config c0;
-  c0.resolution = "tiny";
-  c0.mesh = "blocks";
-  c0.t_end = 0.01;
-  c0.initial_speed = 8.0;
-  c0.quiet = true;
-  c0.out = base.string();
-  c0.checkpoint_every = 0.01;
-  parafsi::scene::run_drop(c0);
-  REQUIRE(fs::exists(base / "checkpoint.ckpt"));
-  c0.out.clear();
-  c0.checkpoint_every = 0;
-  c0.restart = (base / "checkpoint.ckpt").string();
-  c0.t_end = 0.015;
+  const std::filesystem::path base = std::filesystem::temp_directory_path() / "parafsi_drop_signature_blocks";
+  const parafsi::scene::drop_config c0 = checkpointed(base, "blocks");
   using cfg = parafsi::scene::drop_config;
-  struct change {
-    const char* name;
-    void (*apply)(cfg&);
-  };
+  using change = signature_change;
   const change changes[] = {
       {"block_size", [](cfg& c) { c.block_size = 4; }},
       {"refine_every", [](cfg& c) { c.refine_every = 3; }},
@@ -260,16 +255,10 @@ TEST_CASE("drop restart on blocks: a changed block-mesh parameter is refused by 
       {"root_blocks", [](cfg& c) { c.root_blocks = 1; }},
       {"mesh", [](cfg& c) { c.mesh = "tensor"; }},
   };
-  for (const change& ch : changes) {
-    CAPTURE(ch.name);
-    cfg c = c0;
-    ch.apply(c);
-    const std::string expected = std::string("scene parameter '") + ch.name + "' is ";
-    CHECK_THROWS_WITH_AS(parafsi::scene::run_drop(c), doctest::Contains(expected.c_str()), parafsi::invalid_input);
-  }
+  refused_by_name(c0, changes);
   const auto r = parafsi::scene::run_drop(c0);  // the same scene restarts
   CHECK(r.history.size() == 4);
-  fs::remove_all(base);
+  std::filesystem::remove_all(base);
 }
 
 // Settings that would be dropped silently are refused before anything is built, naming

@@ -203,7 +203,8 @@ int main(int argc, char** argv) {
         for (pf::index_t i = 0; i < as.node_set().size(); ++i) pts[std::size_t(i)] = as.node_set().position(i);
         const auto& ml = fl.turbulence();
         pf::fluid::distance_to_points(fl.grid(), pts, ml.c_l * ml.ref_length / ml.kappa,
-                                      std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())));
+                                      std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())),
+                                      true);
       }
       auto run = [&](auto cpl) -> int {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};

@@ -25,8 +25,10 @@ namespace parafsi::fluid {
 
 /// d_w on every interior cell of `grid` (flat index; with `ghosts`, on the ghost layers too,
 /// else they are left untouched) from `points` (box coordinates) within `reach` (m); `out`
-/// has grid.total_cells() entries. A block of a block mesh fills its ghosts as well, so the
-/// eddy viscosity of a ghost cell is its neighbour's.
+/// has grid.total_cells() entries. The viscous pass computes μ_t on the first ghost layer,
+/// so fill the ghosts (a block of a block mesh: its neighbour's eddy viscosity; a box: a
+/// boundary ghost within reach of a point then takes its own distance, not the full mixing
+/// length, and a box and a one-level block mesh agree to round-off there).
 inline void distance_to_points(const rectilinear_grid& grid, std::span<const Eigen::Vector3d> points, double reach,
                                std::span<double> out, bool ghosts = false) {
   require(std::isfinite(reach) && reach > 0, "fluid::distance_to_points: reach must be finite and > 0, got ", reach);

@@ -743,7 +743,7 @@ class drop_run {
         });
       } else {
         fluid::distance_to_points(f.grid(), wall_points_, ml.wall_reach(std::numeric_limits<double>::infinity()),
-                                  std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())));
+                                  std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())), true);
       }
     }
   }

@@ -26,6 +26,34 @@ namespace fb = parafsi::fluid::blocks;
 namespace {
 constexpr double rho0 = 1.0, p0 = 1.0;  // c ≈ 1.18 m/s: viscous and acoustic steps alike
 
+/// The mixing length's wall distance from `pts` on a box solver and a block mesh, ghosts
+/// included on both (the viscous pass computes μ_t on the first ghost layer).
+template <class Box, class Blocks>
+void fill_wall_distance(Box& box, Blocks& blk, const std::vector<Eigen::Vector3d>& pts, double reach) {
+  const auto& g = box.grid();
+  fluid::distance_to_points(g, pts, reach, std::span<double>(box.wall_distance(), std::size_t(g.total_cells())), true);
+  for (index_t id = 0; id < blk.block_count(); ++id) {
+    const auto& bg = blk.block_at(id).grid;
+    fluid::distance_to_points(bg, pts, reach, std::span<double>(blk.wall_distance(id), std::size_t(bg.total_cells())),
+                              true);
+  }
+}
+
+/// `steps` steps of both at the box's stable step (checking the blocks' equals it); the
+/// largest relative state difference met.
+template <class Box, class Blocks>
+double lockstep(Box& box, Blocks& blk, int steps) {
+  double worst = 0;
+  for (int n = 0; n < steps; ++n) {
+    const double dt = box.stable_dt(0.5);
+    CHECK(blk.stable_dt(0.5) == doctest::Approx(dt).epsilon(1e-12));
+    box.step(dt);
+    blk.step(dt);
+    worst = std::max(worst, pft::max_block_box_difference(blk, box));
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST_CASE("viscous block mesh: one level reproduces the box solver to round-off, viscous step limit included") {
@@ -132,23 +160,10 @@ TEST_CASE("eddy viscosity on blocks: one level reproduces the box solver (Smagor
       std::vector<Eigen::Vector3d> pts;
       for (int a = 0; a <= 10; ++a)
         for (int b = 0; b <= 10; ++b) pts.emplace_back(0.3 + 0.04 * a, 0.3 + 0.04 * b, 0.5 + 0.01 * a);
-      const double reach = closure.c_l * closure.ref_length / closure.kappa;
-      const auto& g = box.grid();
-      fluid::distance_to_points(g, pts, reach, std::span<double>(box.wall_distance(), std::size_t(g.total_cells())));
-      for (index_t id = 0; id < blk.block_count(); ++id) {
-        const auto& bg = blk.block_at(id).grid;
-        fluid::distance_to_points(bg, pts, reach,
-                                  std::span<double>(blk.wall_distance(id), std::size_t(bg.total_cells())), true);
-      }
+      fill_wall_distance(box, blk, pts, closure.c_l * closure.ref_length / closure.kappa);
     }
-    double worst = 0, mut = 0;
-    for (int n = 0; n < 20; ++n) {
-      const double dt = box.stable_dt(0.5);
-      CHECK(blk.stable_dt(0.5) == doctest::Approx(dt).epsilon(1e-12));
-      box.step(dt);
-      blk.step(dt);
-      worst = std::max(worst, pft::max_block_box_difference(blk, box));
-    }
+    const double worst = lockstep(box, blk, 20);
+    double mut = 0;
     const auto& g = box.grid();
     for (index_t c = 0; c < g.total_cells(); ++c) mut = std::max(mut, box.eddy_viscosity()[c]);
     MESSAGE(std::string(label), ": 20 steps, max relative state difference ", worst, "; largest mu_t ", mut,
@@ -203,24 +218,12 @@ TEST_CASE("viscous block mesh at the box's boundaries: slip walls, far field, ou
     pts.emplace_back(0.02, 0.02, 0.05 * a);
     pts.emplace_back(0.75, 0.05 * a, 0.5);
   }
-  const double reach = ml.c_l * ml.ref_length / ml.kappa;
-  const auto& g = box.grid();
   // Ghosts included on both: the eddy viscosity of a ghost beside the wall corner reads its
   // own distance (left at "far", the box's ghost μ_t would take the full mixing length).
-  fluid::distance_to_points(g, pts, reach, std::span<double>(box.wall_distance(), std::size_t(g.total_cells())), true);
-  for (index_t id = 0; id < blk.block_count(); ++id) {
-    const auto& bg = blk.block_at(id).grid;
-    fluid::distance_to_points(bg, pts, reach, std::span<double>(blk.wall_distance(id), std::size_t(bg.total_cells())),
-                              true);
-  }
-  double worst = 0, mut = 0;
-  for (int n = 0; n < 30; ++n) {
-    const double dt = box.stable_dt(0.5);
-    CHECK(blk.stable_dt(0.5) == doctest::Approx(dt).epsilon(1e-12));
-    box.step(dt);
-    blk.step(dt);
-    worst = std::max(worst, pft::max_block_box_difference(blk, box));
-  }
+  fill_wall_distance(box, blk, pts, ml.c_l * ml.ref_length / ml.kappa);
+  const double worst = lockstep(box, blk, 30);
+  double mut = 0;
+  const auto& g = box.grid();
   for (index_t c = 0; c < g.total_cells(); ++c) mut = std::max(mut, box.eddy_viscosity()[c]);
   MESSAGE(
       "walls, far field, outflow, sponge; 12 blocks vs the 24x16x16 box, 30 viscous steps: max relative state "

@@ -58,6 +58,40 @@ bool same_totals(const fluid::totals& a, const fluid::totals& b) {
   return a.mass == b.mass && a.momentum == b.momentum && a.energy == b.energy && a.kinetic == b.kinetic;
 }
 
+/// Entries in which the halo's exchange lists (built from this process's own blocks, the
+/// sends by all-to-all) differ from this process's part of the whole mesh's transfers
+/// (blocks::plan_transfers over every block's plan), summed over processes.
+template <class S>
+long list_mismatches(S& solver, const pf::mpi::block_halo& h) {
+  const auto m = solver.mesh_view();
+  const index_t nb = index_t(m.plan->size());
+  const int P = world_size(), me = world_rank();
+  std::vector<int> owner(std::size_t(nb), 0);
+  std::vector<char> everywhere(std::size_t(nb), 0);
+  for (int r = 0; r < P; ++r)
+    for (index_t b : h.owned()[std::size_t(r)]) owner[std::size_t(b)] = r;
+  for (index_t b = 0; b < nb; ++b) everywhere[std::size_t(b)] = P > 1 && h.everywhere(b);
+  const auto [state, regs] = fb::plan_transfers(*m.plan, *m.corrections, m.n, owner, everywhere, P);
+  long bad = 0;
+  auto compare = [&](const std::vector<fb::transfer>& all, const auto& send, const auto& recv) {
+    const auto ranks = std::size_t(P);
+    std::vector<std::vector<fb::cell_ref>> s(ranks), r(ranks);
+    for (const auto& t : all) {
+      if (t.from == me) s[std::size_t(t.to)].push_back(t.what);
+      if (t.to == me) r[std::size_t(t.from)].push_back(t.what);
+    }
+    for (int q = 0; q < P; ++q) {
+      bad += s[std::size_t(q)] != send[std::size_t(q)];
+      bad += r[std::size_t(q)] != recv[std::size_t(q)];
+    }
+  };
+  compare(state, h.state_sends(), h.state_receives());
+  compare(regs, h.register_sends(), h.register_receives());
+  long all = 0;
+  MPI_Allreduce(&bad, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
 }  // namespace
 
 TEST_CASE("partition: contiguous ranges of nearly equal weight, none empty") {
@@ -92,6 +126,17 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
   auto dist = make();
   auto halo = std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD);
   dist->set_halo(halo);
+  long list_bad = list_mismatches(*dist, *halo);
+  {
+    // The same with the finest level computed by every process (replicated blocks read
+    // nothing remote and are read without messages).
+    auto repl = make();
+    pf::mpi::halo_options o;
+    o.replicate_finest = true;
+    auto h = std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD, o);
+    repl->set_halo(h);
+    list_bad += list_mismatches(*repl, *h);
+  }
   const auto owned = index_t(dist->computed_blocks().size());
   CHECK(owned > 0);
   if (P > 1) CHECK(owned < dist->block_count());  // this process computes only its share
@@ -145,6 +190,7 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
       const bool b = dist->regrid(target_of(*dist), 2);
       CHECK(a == b);
       regrids += a;
+      if (b) list_bad += list_mismatches(*dist, *halo);
     }
   }
   const int threads = pf::parallel::max_threads();
@@ -160,6 +206,7 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
             double(after.bytes - before.bytes) / double(std::max<long>(1, after.exchanges - before.exchanges)),
             " bytes per stage from rank 0; cells differing from one process: ", bad);
   CHECK(regrids >= 2);
+  CHECK(list_bad == 0);  // the lists from own blocks are the whole mesh's, at the start and after every regrid
   CHECK(dt_differ == 0);
   CHECK(bad == 0);
   CHECK(same_totals(serial->totals(), dist->totals()));

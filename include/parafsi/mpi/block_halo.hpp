@@ -10,19 +10,19 @@
 /// order by the blocks' costs into one contiguous range per rank (blocks::partition); with
 /// `replicate_finest` the finest level's blocks (every block of a one-level mesh) are left
 /// out of the partition and computed by every process (a coupling's region, for a coupling that reads the air anywhere
-/// near the structure: coupling::penalty). Then, from the replicated plans, lists for every other rank
-/// the cells it must send there and receive from there: the interior cells the ghost plans of the receiver's blocks
-/// read (blocks::plan_reads) and the register entries its flux corrections read (blocks::correction_reads), sorted by
-/// (block, cell), so sender and receiver agree on the order without sending it. A state exchange is then one message
-/// per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps the
-/// owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read remote
-/// cells, so the messages overlap that work. The register exchange likewise: its messages leave once the blocks whose
-/// registers other ranks read are swept (begin_registers) and travel while the solver sweeps the remaining blocks and
-/// corrects the coarse blocks whose corrections read only this rank's registers (end_registers waits). The reductions
-/// are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the caller. A
-/// coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of the faces each
-/// process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so every process
-/// replays every face alike. Results are therefore bitwise those of one process.
+/// near the structure: coupling::penalty). Then it lists, per other rank, what it receives from there: the
+/// interior cells the ghost plans of its own blocks read (blocks::plan_reads) and the register entries their flux
+/// corrections read (blocks::correction_reads), sorted by (block, cell); one MPI_Alltoallv hands each list to its
+/// sender, whose send list it becomes, so a process walks only its own blocks' plans. A state exchange is then one
+/// message per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps
+/// the owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read
+/// remote cells, so the messages overlap that work. The register exchange likewise: its messages leave once the blocks
+/// whose registers other ranks read are swept (begin_registers) and travel while the solver sweeps the remaining blocks
+/// and corrects the coarse blocks whose corrections read only this rank's registers (end_registers waits). The
+/// reductions are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the
+/// caller. A coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of the
+/// faces each process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so every
+/// process replays every face alike. Results are therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
 /// block's arrays), and a gather-free regrid.
@@ -134,33 +134,38 @@ class block_halo final : public fluid::blocks::halo {
         owner_[std::size_t(spread[std::size_t(k)])] = r;
         owned_[std::size_t(r)].push_back(spread[std::size_t(k)]);
       }
-    // This process's part of the whole mesh's transfers, already sorted by (peer, block, cell).
-    const auto [state, regs] = fluid::blocks::plan_transfers(*m_.plan, *m_.corrections, m_.n, owner_, everywhere_,
-                                                             size_);
-    auto split = [&](const std::vector<fluid::blocks::transfer>& all, lists& send, lists& recv) {
-      send.assign(std::size_t(size_), {});
-      recv.assign(std::size_t(size_), {});
-      for (const auto& t : all) {
-        if (t.from == rank_) send[std::size_t(t.to)].push_back(t.what);
-        if (t.to == rank_) recv[std::size_t(t.from)].push_back(t.what);
-      }
-    };
-    split(state, state_send_, state_recv_);
-    split(regs, reg_send_, reg_recv_);
+    // This process's receives, from the blocks it computes only: the cells their ghost plans
+    // and the register entries their flux corrections read of blocks computed elsewhere, per
+    // owner, sorted by (block, cell) without repeats (blocks::plan_transfers' order). Its
+    // sends are the other processes' receives from it, which one all-to-all brings, so no
+    // process walks the whole mesh's plans.
     std::vector<index_t> computed;
     remote_reader_.assign(std::size_t(nb), 0);
     remote_corrector_.assign(std::size_t(nb), 0);
     register_sender_.assign(std::size_t(nb), 0);
+    state_recv_.assign(std::size_t(size_), {});
+    reg_recv_.assign(std::size_t(size_), {});
     for (index_t b = 0; b < nb; ++b) {
       if (!computes(b)) continue;
       computed.push_back(b);
       fluid::blocks::plan_reads((*m_.plan)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
-        if (!computes(c.block)) remote_reader_[std::size_t(b)] = 1;
+        if (computes(c.block)) return;
+        remote_reader_[std::size_t(b)] = 1;
+        state_recv_[std::size_t(owner_[std::size_t(c.block)])].push_back(c);
       });
       fluid::blocks::correction_reads((*m_.corrections)[std::size_t(b)], m_.n, [&](const cell_ref& c) {
-        if (!computes(c.block)) remote_corrector_[std::size_t(b)] = 1;
+        if (computes(c.block)) return;
+        remote_corrector_[std::size_t(b)] = 1;
+        reg_recv_[std::size_t(owner_[std::size_t(c.block)])].push_back(c);
       });
     }
+    for (auto* recv : {&state_recv_, &reg_recv_})
+      for (auto& items : *recv) {
+        std::sort(items.begin(), items.end());
+        items.erase(std::unique(items.begin(), items.end()), items.end());
+      }
+    state_send_ = requests_to_sends(state_recv_);
+    reg_send_ = requests_to_sends(reg_recv_);
     for (const auto& items : reg_send_)
       for (const cell_ref& c : items) register_sender_[std::size_t(c.block)] = 1;
     return computed;
@@ -251,9 +256,55 @@ class block_halo final : public fluid::blocks::halo {
   /// Cells (state) this rank sends per exchange to each rank.
   const lists& state_sends() const noexcept { return state_send_; }
   const lists& register_sends() const noexcept { return reg_send_; }
+  /// Cells (state) this rank receives per exchange from each rank.
+  const lists& state_receives() const noexcept { return state_recv_; }
+  const lists& register_receives() const noexcept { return reg_recv_; }
 
  private:
   bool computes(index_t b) const noexcept { return everywhere_[std::size_t(b)] || owner_[std::size_t(b)] == rank_; }
+
+  /// What each rank asks of this one, from what this one asks of each rank (recv[r]: the
+  /// items it receives from r, in the order r must send them): MPI_Alltoall of the counts,
+  /// MPI_Alltoallv of the (block, cell) pairs. Collective.
+  lists requests_to_sends(const lists& recv) {
+    constexpr std::size_t most = 2000000000;  // values in one MPI message (int counts)
+    const auto ranks = std::size_t(size_);
+    std::vector<int> ask(ranks), asked(ranks), ask_at(ranks), asked_at(ranks);
+    std::size_t out = 0;
+    for (int r = 0; r < size_; ++r) {
+      const std::size_t k = 2 * recv[std::size_t(r)].size();
+      require(out + k < most, "mpi::block_halo: too many halo items for one list message (", out + k, ")");
+      ask_at[std::size_t(r)] = int(out);
+      ask[std::size_t(r)] = int(k);
+      out += k;
+    }
+    std::vector<long> sbuf;
+    sbuf.reserve(out);
+    for (const auto& items : recv)
+      for (const cell_ref& c : items) {
+        sbuf.push_back(c.block);
+        sbuf.push_back(c.cell);
+      }
+    MPI_Alltoall(ask.data(), 1, MPI_INT, asked.data(), 1, MPI_INT, comm_);
+    std::size_t in = 0;
+    for (int r = 0; r < size_; ++r) {
+      const auto k = std::size_t(asked[std::size_t(r)]);
+      require(in + k < most, "mpi::block_halo: too many halo items for one list message (", in + k, ")");
+      asked_at[std::size_t(r)] = int(in);
+      in += k;
+    }
+    std::vector<long> rbuf(in);
+    MPI_Alltoallv(sbuf.data(), ask.data(), ask_at.data(), MPI_LONG, rbuf.data(), asked.data(), asked_at.data(),
+                  MPI_LONG, comm_);
+    lists send(ranks);
+    for (int r = 0; r < size_; ++r) {
+      auto& items = send[std::size_t(r)];
+      const auto from = std::size_t(asked_at[std::size_t(r)]), to = from + std::size_t(asked[std::size_t(r)]);
+      items.reserve((to - from) / 2);
+      for (std::size_t k = from; k < to; k += 2) items.push_back(cell_ref{index_t(rbuf[k]), index_t(rbuf[k + 1])});
+    }
+    return send;
+  }
 
   /// MPI_Allgatherv of `per` values per partitioned block, each from its owner:
   /// io(block, buffer, pack) packs (pack true) or unpacks the block's values.

@@ -27,7 +27,11 @@
 /// sample is returned as it is. `at(x, i)` sums over k from kl to kr in increasing order,
 /// so the value of sample i depends only on the samples in its window: a series filtered
 /// piecewise, as it grows (a window complete once H later samples exist), gives the same
-/// bits as the whole series filtered at once.
+/// bits as the whole series filtered at once. Every product-and-sum is an explicit
+/// std::fma, so the bits do not depend on where the compiler inlines `at` either: with
+/// FMA instructions (-march=native, -ffp-contract=fast, GCC's default) an `a * b + c` may
+/// be fused in one inlined copy and not in another, and a history column filled row by
+/// row then differed from the whole series in the last bit.
 ///
 ///   io::gaussian_lowpass f(10.0, 0.005);   // f_c = 10 Hz, Δt = 5 ms: σ = 13.25 ms, H = 11
 ///   std::vector<double> y = f.apply(x);
@@ -86,20 +90,20 @@ class gaussian_lowpass {
     const std::ptrdiff_t kl = -std::min(H, ii), kr = std::min(H, std::ptrdiff_t(n) - 1 - ii);
     if (kl == -H && kr == H) {
       double y = 0;
-      for (std::ptrdiff_t k = -H; k <= H; ++k) y += wn_[std::size_t(k + H)] * x(std::size_t(ii + k));
+      for (std::ptrdiff_t k = -H; k <= H; ++k) y = std::fma(wn_[std::size_t(k + H)], x(std::size_t(ii + k)), y);
       return y;
     }
     double S0 = 0, S1 = 0, S2 = 0, T0 = 0, T1 = 0;
     for (std::ptrdiff_t k = kl; k <= kr; ++k) {
-      const double w = w_[std::size_t(k + H)], dk = double(k), xk = x(std::size_t(ii + k));
+      const double w = w_[std::size_t(k + H)], dk = double(k), xk = x(std::size_t(ii + k)), wk = w * dk;
       S0 += w;
-      S1 += w * dk;
-      S2 += w * dk * dk;
-      T0 += w * xk;
-      T1 += w * dk * xk;
+      S1 += wk;
+      S2 = std::fma(wk, dk, S2);
+      T0 = std::fma(w, xk, T0);
+      T1 = std::fma(wk, xk, T1);
     }
-    const double det = S0 * S2 - S1 * S1;
-    return det > 0 ? (S2 * T0 - S1 * T1) / det : x(i);
+    const double det = std::fma(S0, S2, -(S1 * S1));
+    return det > 0 ? std::fma(S2, T0, -(S1 * T1)) / det : x(i);
   }
   double at(std::span<const double> x, std::size_t i) const {
     return at(x.size(), i, [&](std::size_t j) { return x[j]; });

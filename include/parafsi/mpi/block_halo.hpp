@@ -12,17 +12,18 @@
 /// out of the partition and computed by every process (a coupling's region, for a coupling that reads the air anywhere
 /// near the structure: coupling::penalty). Then it lists, per other rank, what it receives from there: the
 /// interior cells the ghost plans of its own blocks read (blocks::plan_reads) and the register entries their flux
-/// corrections read (blocks::correction_reads), sorted by (block, cell); one MPI_Alltoallv hands each list to its
-/// sender, whose send list it becomes, so a process walks only its own blocks' plans. A state exchange is then one
-/// message per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the ghosts of and sweeps
-/// the owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the blocks that read
-/// remote cells, so the messages overlap that work. The register exchange likewise: its messages leave once the blocks
-/// whose registers other ranks read are swept (begin_registers) and travel while the solver sweeps the remaining blocks
-/// and corrects the coarse blocks whose corrections read only this rank's registers (end_registers waits). The
-/// reductions are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order by the
-/// caller. A coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of the
-/// faces each process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so every
-/// process replays every face alike. Results are therefore bitwise those of one process.
+/// corrections read (blocks::correction_reads), sorted by (block, cell); an MPI_Alltoall of the counts and an
+/// MPI_Alltoallv of the lists (once for the state, once for the registers) hand each list to its sender, whose
+/// send list it becomes, so a process walks only its own blocks' plans. rebuild is therefore collective. A state
+/// exchange is then one message per neighbouring rank each way: MPI_Irecv/MPI_Isend (begin_state), the solver fills the
+/// ghosts of and sweeps the owned blocks whose plans read only this rank's cells, then MPI_Waitall (end_state) and the
+/// blocks that read remote cells, so the messages overlap that work. The register exchange likewise: its messages leave
+/// once the blocks whose registers other ranks read are swept (begin_registers) and travel while the solver sweeps the
+/// remaining blocks and corrects the coarse blocks whose corrections read only this rank's registers (end_registers
+/// waits). The reductions are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order
+/// by the caller. A coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of
+/// the faces each process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so
+/// every process replays every face alike. Results are therefore bitwise those of one process.
 ///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
 /// block's arrays), and a gather-free regrid.
@@ -36,6 +37,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -267,13 +269,21 @@ class block_halo final : public fluid::blocks::halo {
   /// items it receives from r, in the order r must send them): MPI_Alltoall of the counts,
   /// MPI_Alltoallv of the (block, cell) pairs. Collective.
   lists requests_to_sends(const lists& recv) {
+    static_assert(std::is_same_v<index_t, long>, "block_halo sends cell_ref fields as MPI_LONG");
     constexpr std::size_t most = 2000000000;  // values in one MPI message (int counts)
     const auto ranks = std::size_t(size_);
     std::vector<int> ask(ranks), asked(ranks), ask_at(ranks), asked_at(ranks);
+    // The sizes are checked on every process before the lists move, and the verdict shared,
+    // so that a list too long for one message stops every process, not one of them.
     std::size_t out = 0;
+    for (const auto& items : recv) out += 2 * items.size();
+    std::size_t most_out = out;
+    MPI_Allreduce(MPI_IN_PLACE, &most_out, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
+    require(most_out < most, "mpi::block_halo: a process asks for ", most_out,
+            " halo values in one list message, more than ", most);
+    out = 0;
     for (int r = 0; r < size_; ++r) {
       const std::size_t k = 2 * recv[std::size_t(r)].size();
-      require(out + k < most, "mpi::block_halo: too many halo items for one list message (", out + k, ")");
       ask_at[std::size_t(r)] = int(out);
       ask[std::size_t(r)] = int(k);
       out += k;
@@ -287,11 +297,15 @@ class block_halo final : public fluid::blocks::halo {
       }
     MPI_Alltoall(ask.data(), 1, MPI_INT, asked.data(), 1, MPI_INT, comm_);
     std::size_t in = 0;
+    for (int r = 0; r < size_; ++r) in += std::size_t(asked[std::size_t(r)]);
+    std::size_t most_in = in;
+    MPI_Allreduce(MPI_IN_PLACE, &most_in, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
+    require(most_in < most, "mpi::block_halo: a process is asked for ", most_in,
+            " halo values in one list message, more than ", most);
+    in = 0;
     for (int r = 0; r < size_; ++r) {
-      const auto k = std::size_t(asked[std::size_t(r)]);
-      require(in + k < most, "mpi::block_halo: too many halo items for one list message (", in + k, ")");
       asked_at[std::size_t(r)] = int(in);
-      in += k;
+      in += std::size_t(asked[std::size_t(r)]);
     }
     std::vector<long> rbuf(in);
     MPI_Alltoallv(sbuf.data(), ask.data(), ask_at.data(), MPI_LONG, rbuf.data(), asked.data(), asked_at.data(),

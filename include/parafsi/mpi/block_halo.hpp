@@ -273,21 +273,25 @@ class block_halo final : public fluid::blocks::halo {
     constexpr std::size_t most = 2000000000;  // values in one MPI message (int counts)
     const auto ranks = std::size_t(size_);
     std::vector<int> ask(ranks), asked(ranks), ask_at(ranks), asked_at(ranks);
-    // The sizes are checked on every process before the lists move, and the verdict shared,
-    // so that a list too long for one message stops every process, not one of them.
-    std::size_t out = 0;
-    for (const auto& items : recv) out += 2 * items.size();
-    std::size_t most_out = out;
-    MPI_Allreduce(MPI_IN_PLACE, &most_out, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
-    require(most_out < most, "mpi::block_halo: a process asks for ", most_out,
-            " halo values in one list message, more than ", most);
-    out = 0;
-    for (int r = 0; r < size_; ++r) {
-      const std::size_t k = 2 * recv[std::size_t(r)].size();
-      ask_at[std::size_t(r)] = int(out);
-      ask[std::size_t(r)] = int(k);
-      out += k;
-    }
+    // Counts and offsets per rank of count_of(r) values. The total is checked on every
+    // process before anything moves and the verdict shared, so that a list too long for one
+    // message (int counts) stops every process, not one of them.
+    auto offsets = [&](auto&& count_of, std::vector<int>& count, std::vector<int>& at, const char* what) {
+      std::size_t total = 0;
+      for (int r = 0; r < size_; ++r) total += count_of(r);
+      std::size_t largest = total;
+      MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
+      require(largest < most, "mpi::block_halo: a process ", what, " ", largest,
+              " halo values in one list message, more than ", most);
+      total = 0;
+      for (int r = 0; r < size_; ++r) {
+        count[std::size_t(r)] = int(count_of(r));
+        at[std::size_t(r)] = int(total);
+        total += count_of(r);
+      }
+      return total;
+    };
+    const std::size_t out = offsets([&](int r) { return 2 * recv[std::size_t(r)].size(); }, ask, ask_at, "asks for");
     std::vector<long> sbuf;
     sbuf.reserve(out);
     for (const auto& items : recv)
@@ -296,17 +300,8 @@ class block_halo final : public fluid::blocks::halo {
         sbuf.push_back(c.cell);
       }
     MPI_Alltoall(ask.data(), 1, MPI_INT, asked.data(), 1, MPI_INT, comm_);
-    std::size_t in = 0;
-    for (int r = 0; r < size_; ++r) in += std::size_t(asked[std::size_t(r)]);
-    std::size_t most_in = in;
-    MPI_Allreduce(MPI_IN_PLACE, &most_in, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
-    require(most_in < most, "mpi::block_halo: a process is asked for ", most_in,
-            " halo values in one list message, more than ", most);
-    in = 0;
-    for (int r = 0; r < size_; ++r) {
-      asked_at[std::size_t(r)] = int(in);
-      in += std::size_t(asked[std::size_t(r)]);
-    }
+    const std::size_t in = offsets([&](int r) { return std::size_t(asked[std::size_t(r)]); }, asked, asked_at,
+                                   "is asked for");
     std::vector<long> rbuf(in);
     MPI_Alltoallv(sbuf.data(), ask.data(), ask_at.data(), MPI_LONG, rbuf.data(), asked.data(), asked_at.data(),
                   MPI_LONG, comm_);

@@ -172,7 +172,7 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
       return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
     };
   };
-  int regrids = 0, dt_differ = 0;
+  int regrids = 0, dt_differ = 0, indicator_differ = 0;
   const auto before = halo->counters();
   // The one-process run on one thread, the distributed one on two threads per process (the
   // block loops run threaded from 32 768 cells on): the same bits for any process and
@@ -187,6 +187,8 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
     dist->step(dtd);
     dt_differ += dts != dtd;
     if (n % 4 == 3) {
+      // The vorticity criterion's values: each process its blocks', gathered.
+      indicator_differ += serial->vorticity_indicator() != dist->vorticity_indicator();
       const bool a = serial->regrid(target_of(*serial), 2);
       const bool b = dist->regrid(target_of(*dist), 2);
       CHECK(a == b);
@@ -201,12 +203,20 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
   const long bad = mismatches(state_of(*serial), state_of(*dist));
   if (world_rank() == 0)
     MESSAGE(P, " processes of ", threads, " threads: ", dist->cell_count(), " cells in ", dist->block_count(),
-            " blocks (levels 0-", dist->tree().finest_level(), "), ", regrids, " regrids, ",
+            " blocks (levels 0-", dist->tree().finest_level(), "), ", regrids, " regrids fetching ",
+            after.fetched_blocks - before.fetched_blocks, " blocks to rank 0 (",
+            after.state_gathers - before.state_gathers, " whole-state gathers), ",
             (after.messages - before.messages) / std::max<long>(1, after.exchanges - before.exchanges),
             " state+register messages and ",
             double(after.bytes - before.bytes) / double(std::max<long>(1, after.exchanges - before.exchanges)),
             " bytes per stage from rank 0; cells differing from one process: ", bad);
   CHECK(regrids >= 2);
+  CHECK(indicator_differ == 0);
+  // A regrid moves the blocks each process builds from, never the whole state.
+  CHECK(after.state_gathers == before.state_gathers);
+  long fetched = long(after.fetched_blocks - before.fetched_blocks);
+  MPI_Allreduce(MPI_IN_PLACE, &fetched, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  if (P > 1) CHECK(fetched > 0);
   CHECK(list_bad == 0);  // the lists from own blocks are the whole mesh's, at the start and after every regrid
   CHECK(dt_differ == 0);
   CHECK(bad == 0);

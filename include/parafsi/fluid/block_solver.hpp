@@ -411,21 +411,28 @@ class block_solver {
   /// covering it did, or the mean of the old leaves it merges), and so does the first
   /// regrid call that leaves the mesh as it is while the partition still weighs every
   /// block 1 (after set_halo or a restart); this call is for a mesh that stays.
-  /// Replicated blocks (halo::everywhere) weigh the mean of the others. The state is
-  /// gathered first (a block may change process), so this costs a regrid's gather; the
-  /// results do not change by a bit, only who computes what.
+  /// Replicated blocks (halo::everywhere) weigh the mean of the others. A block that
+  /// changes process is fetched from its old owner (halo::fetch_blocks; no whole-state
+  /// gather); the results do not change by a bit, only who computes what.
   void rebalance() {
     if (!halo_ || halo_->size() == 1) return;
     reattach_if_moved();
-    gather();
-    weight_ = measured_weights(tree_);
+    std::vector<double> w = measured_weights(tree_, tree_);
+    // The blocks this process takes over come from their present owners.
+    forecast_ = halo_->would_compute(tree_, w.empty() ? std::vector<double>(blocks_.size(), 1.0) : w);
+    std::vector<index_t> wanted;
+    for (index_t id = 0; id < block_count(); ++id)
+      if (forecast_[std::size_t(id)] && !computes_[std::size_t(id)]) wanted.push_back(id);
+    halo_->fetch_blocks(wanted);
+    weight_ = std::move(w);
     attach_halo();
+    require(forecast_ == computes_, "fluid::block_solver::rebalance: the partition differs from its forecast");
   }
   /// Every block's interior cells from its owner to every process (collective; a no-op
   /// when not distributed).
   void gather() {
     reattach_if_moved();
-    if (halo_) halo_->gather_state();
+    if (halo_ && halo_->size() > 1) halo_->gather_state();
     gathered_ = true;
   }
   /// What a halo reads and writes: the tree, plans, corrections, storage and block costs.
@@ -589,11 +596,18 @@ class block_solver {
   /// times the cell's smallest width, in m/s: how much the velocity turns across one cell,
   /// a measure of how well the leaf resolves the vortical flow it holds (the wake); the
   /// input of blocks::leaf_indicator.
+  /// Distributed, each process computes its blocks' values (their ghosts through the halo's
+  /// state exchange) and the values are gathered (collective).
   std::vector<double> vorticity_indicator() {
-    gather();
-    fill_ghosts_all(t_, 0, block_count());
+    reattach_if_moved();
+    if (halo_) {
+      halo_->begin_state();
+      halo_->end_state();
+    }
+    const auto geo = detail::geometry(pose_);
+    for_computed([&](index_t id) { fill_block_ghosts(id, t_, geo); });
     std::vector<double> out(blocks_.size(), 0.0);
-    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+    for_computed([&](index_t id) {
       const block& b = blocks_[std::size_t(id)];
       const auto& g = b.grid;
       const auto U = detail::conserved_ptrs(b.U);
@@ -621,6 +635,7 @@ class block_solver {
           }
       out[std::size_t(id)] = m;
     });
+    if (halo_) halo_->gather_blocks(out, 1);
     return out;
   }
 
@@ -634,7 +649,10 @@ class block_solver {
   /// cells it covers. Levels are capped at max_level. Returns whether the mesh changed.
   /// Distributed, a call may change the blocks this process computes even when it returns
   /// false (the first cut by measured cost, see rebalance()): refresh per-block data of your
-  /// own (e.g. a wall distance) from computed_blocks() before the next step.
+  /// own (e.g. a wall distance) from computed_blocks() before the next step. It moves no
+  /// whole state: each process builds the new blocks it will compute (the halo's forecast
+  /// of the new partition) from the old blocks it fetches (fetch_sources); the other blocks
+  /// hold a gas at rest until gather().
   template <class Target>
   bool regrid(Target&& target, int max_level) {
     require(max_level >= 0 && max_level <= blocks::tree::max_depth,
@@ -671,18 +689,26 @@ class block_solver {
       if (halo_ && halo_->size() > 1 && weight_.empty() && cost_steps_ > 0) rebalance();
       return false;
     }
-    gather();  // a distributed mesh: every process moves every block (the mesh is replicated)
-    fill_ghosts_all(t_, 0, block_count());  // the old mesh's ghosts feed the prolongation slopes
+    // Split over processes, each process builds only the new blocks it will compute, from
+    // the old blocks it fetches (fetch_sources); otherwise every block from every block.
+    const bool split = halo_ && halo_->size() > 1;
+    reattach_if_moved();
+    std::vector<double> next_weight = halo_ ? measured_weights(tree_, next) : std::vector<double>{};
+    if (split) fetch_sources(next, next_weight);
+    else fill_ghosts_all(t_, 0, block_count());  // the old mesh's ghosts feed the prolongation slopes
     std::vector<block> old = std::move(blocks_);
     const std::unique_ptr<cons_storage> old_U = std::move(U_);  // the old blocks' slices point here
     const std::unique_ptr<turbulence_storage> old_T = std::move(T_);
     blocks::tree old_tree = std::move(tree_);
     tree_ = std::move(next);
-    if (halo_) weight_ = measured_weights(old_tree);  // the old mesh's costs, on the new leaves
-    else weight_.clear();
+    weight_ = std::move(next_weight);  // the old mesh's costs, on the new leaves
     build();
+    require(!split || forecast_ == computes_,
+            "fluid::block_solver::regrid: the partition differs from its forecast (the halo's rebuild and "
+            "would_compute must cut alike)");
     transfer(old, old_tree);
     if constexpr (has_eddy_viscosity) transfer_eddy_viscosity(old, old_tree);
+    gathered_ = !split;  // the other processes' new blocks are not built here
     return true;
   }
 
@@ -691,7 +717,7 @@ class block_solver {
   /// covers (the stricter viscous step). The wall distance starts again at 1e30 (refill it).
   void transfer_eddy_viscosity(const std::vector<block>& old, const blocks::tree& old_tree) {
     const index_t n = n_;
-    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+    for_computed([&](index_t id) {
       block& nb = blocks_[std::size_t(id)];
       double* mu = nb.T.template get<field::mu_t>();
       const blocks::location q = nb.where;
@@ -849,13 +875,13 @@ class block_solver {
     else f();
   }
 
-  /// Weights of tree_'s leaves from the costs measured on the mesh `old` (the current one
-  /// before a regrid; computed_, cost_ and the halo still describe it), the same on every
+  /// Weights of the leaves of `next` from the costs measured on the mesh `old` (the current
+  /// one before a regrid; computed_, cost_ and the halo still describe it), the same on every
   /// process (collective): seconds per step of each block, gathered from the processes
   /// computing them (without a step since the last cut, the last weights; none: empty,
   /// uniform); a new leaf takes the weight of the old leaf covering it, or the mean of the
   /// old leaves one level finer it merges; replicated or unmeasured blocks the mean.
-  std::vector<double> measured_weights(const blocks::tree& old) {
+  std::vector<double> measured_weights(const blocks::tree& old, const blocks::tree& next) {
     const std::size_t nold = std::size_t(old.size());
     std::vector<double> per(nold, 0.0);
     if (cost_steps_ == 0) {                   // no step since the last cut (the same on every process)
@@ -876,9 +902,9 @@ class block_solver {
       }
     }
     const double mean = count > 0 ? sum / double(count) : 1.0;
-    std::vector<double> w(std::size_t(tree_.size()), mean);
-    for (index_t id = 0; id < tree_.size(); ++id) {
-      const blocks::location q = tree_.leaf(id);
+    std::vector<double> w(std::size_t(next.size()), mean);
+    for (index_t id = 0; id < next.size(); ++id) {
+      const blocks::location q = next.leaf(id);
       const blocks::cover c = old.find(q);
       if (c.kind == blocks::cover::leaf) {
         if (per[std::size_t(c.id)] > 0.0) w[std::size_t(id)] = per[std::size_t(c.id)];
@@ -1450,10 +1476,52 @@ class block_solver {
                           /*edge_depth=*/1);
   }
 
-  /// Move the state of the old leaves onto the new ones (regrid).
+  /// Before a distributed regrid to `next` (weights `w`, empty for uniform): the blocks this
+  /// process will compute (forecast_, the halo's partition of next), the old leaves they
+  /// are built from (the leaf covering each, or the leaves it merges) and, for a leaf that
+  /// is prolonged, the cells its ghost plan reads (the prolongation's slopes read its
+  /// ghosts) are fetched from the processes computing them; then those leaves' ghosts are
+  /// filled. Everything transfer() reads is then current here, and nothing else moves.
+  void fetch_sources(const blocks::tree& next, const std::vector<double>& w) {
+    forecast_ = halo_->would_compute(next, w.empty() ? std::vector<double>(std::size_t(next.size()), 1.0) : w);
+    std::vector<char> want(blocks_.size(), 0), prolonged(blocks_.size(), 0);
+    auto under = [&](auto&& self, const blocks::location& o) -> void {
+      const index_t oid = tree_.id_of(o);
+      if (oid >= 0) {
+        want[std::size_t(oid)] = 1;
+        return;
+      }
+      for (int ch = 0; ch < 8; ++ch) self(self, o.child(ch));
+    };
+    for (index_t id = 0; id < next.size(); ++id) {
+      if (!forecast_[std::size_t(id)]) continue;
+      const blocks::location q = next.leaf(id);
+      const blocks::cover c = tree_.find(q);
+      if (c.kind == blocks::cover::leaf) {
+        want[std::size_t(c.id)] = 1;
+        if (tree_.leaf(c.id).level < q.level) prolonged[std::size_t(c.id)] = 1;
+      } else
+        for (int ch = 0; ch < 8; ++ch) under(under, q.child(ch));
+    }
+    std::vector<index_t> fill;
+    for (index_t id = 0; id < block_count(); ++id)
+      if (prolonged[std::size_t(id)]) {
+        fill.push_back(id);
+        blocks::plan_reads(plan_[std::size_t(id)], n_,
+                           [&](const blocks::cell_ref& r) { want[std::size_t(r.block)] = 1; });
+      }
+    std::vector<index_t> wanted;
+    for (index_t id = 0; id < block_count(); ++id)
+      if (want[std::size_t(id)]) wanted.push_back(id);
+    halo_->fetch_blocks(wanted);
+    const auto geo = detail::geometry(pose_);
+    for_ids(fill, [&](index_t id) { fill_block_ghosts(id, t_, geo); });
+  }
+
+  /// Move the state of the old leaves onto the new ones this process computes (regrid).
   void transfer(const std::vector<block>& old, const blocks::tree& old_tree) {
     const index_t n = n_;
-    detail::par_for(threaded_, 0, block_count(), [&](index_t id) {
+    for_computed([&](index_t id) {
       block& nbk = blocks_[std::size_t(id)];
       const blocks::location q = nbk.where;
       const auto U = detail::conserved_ptrs(nbk.U);
@@ -1655,6 +1723,7 @@ class block_solver {
   const block_solver* attached_to_ = nullptr;  ///< the object the halo's pointers point into
   bool gathered_ = true;                       ///< every block's state is current on this process (set by gather())
   std::vector<index_t> computed_;              ///< the blocks this process computes (tree order)
+  std::vector<char> forecast_;                 ///< distributed regrid: the new blocks this process will compute
   std::vector<char> computes_;                 ///< per block: whether this process computes it
   // The blocks this process computes, by what they wait for in a stage (attach_halo):
   std::vector<index_t> local_ids_;           ///< ghosts all local (every block without a halo)

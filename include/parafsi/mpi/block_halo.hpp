@@ -25,8 +25,13 @@
 /// the faces each process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so
 /// every process replays every face alike. Results are therefore bitwise those of one process.
 ///
+/// A regrid or a new partition moves no whole state: each process forecasts the blocks it
+/// will compute (would_compute, the same partition rebuild then makes) and fetches from
+/// their owners only the old blocks those are built from (fetch_blocks: an all-to-all of
+/// the block lists, then one message per peer each way).
+///
 /// Not yet: storage for owned blocks and their neighbours only (every process holds every
-/// block's arrays), and a gather-free regrid.
+/// block's arrays).
 ///
 /// References: Message Passing Interface Forum (2021) MPI: A Message-Passing Interface
 ///   Standard, version 4.0 (non-blocking point-to-point, MPI_Allgatherv);
@@ -116,26 +121,7 @@ class block_halo final : public fluid::blocks::halo {
     // Replicated blocks, then a partition of the others' Morton order by weight.
     // (On a one-level mesh the finest level is every block: all are replicated, which is
     // correct for a coupling and divides nothing.)
-    const int finest = m_.leaves->finest_level();
-    everywhere_.assign(std::size_t(nb), 0);
-    if (opt_.replicate_finest)
-      for (index_t b = 0; b < nb; ++b) everywhere_[std::size_t(b)] = m_.leaves->leaf(b).level == finest;
-    std::vector<index_t> spread;
-    std::vector<double> w;
-    for (index_t b = 0; b < nb; ++b)
-      if (!everywhere_[std::size_t(b)]) {
-        spread.push_back(b);
-        w.push_back(m_.weight[std::size_t(b)]);
-      }
-    const auto cut = spread.empty() ? std::vector<index_t>(std::size_t(size_) + 1, 0)
-                                    : fluid::blocks::partition(w, size_);
-    owner_.assign(std::size_t(nb), 0);
-    owned_.assign(std::size_t(size_), {});
-    for (int r = 0; r < size_; ++r)
-      for (index_t k = cut[std::size_t(r)]; k < cut[std::size_t(r) + 1]; ++k) {
-        owner_[std::size_t(spread[std::size_t(k)])] = r;
-        owned_[std::size_t(r)].push_back(spread[std::size_t(k)]);
-      }
+    assign(*m_.leaves, m_.weight, owner_, everywhere_, owned_);
     // This process's receives, from the blocks it computes only: the cells their ghost plans
     // and the register entries their flux corrections read of blocks computed elsewhere, per
     // owner, sorted by (block, cell) without repeats (blocks::plan_transfers' order). Its
@@ -189,6 +175,7 @@ class block_halo final : public fluid::blocks::halo {
     const index_t n = m_.n;
     const int fields = m_.mu_t.empty() ? 5 : 6;  // the conserved state, and μ_t with a closure
     const fluid::blocks::block_index at{n};
+    ++count_.state_gathers;
     gather_by_owner(fields * n * n * n, [&](index_t b, double* o, bool pack) {
       for (int q = 0; q < fields; ++q) {
         double* u = q < 5 ? (*m_.U)[std::size_t(b)][q] : m_.mu_t[std::size_t(b)];
@@ -201,6 +188,49 @@ class block_halo final : public fluid::blocks::halo {
             }
       }
     });
+  }
+
+  std::vector<char> would_compute(const fluid::blocks::tree& leaves, const std::vector<double>& weight) const override {
+    std::vector<int> owner;
+    std::vector<char> everywhere;
+    std::vector<std::vector<index_t>> owned;
+    assign(leaves, weight, owner, everywhere, owned);
+    std::vector<char> out(everywhere.size(), 0);
+    for (std::size_t b = 0; b < out.size(); ++b) out[b] = size_ == 1 || everywhere[b] || owner[b] == rank_;
+    return out;
+  }
+
+  /// Asks each owner for its listed blocks (one all-to-all of the block lists), then one
+  /// message per peer each way with their interiors (blocks in ascending order).
+  void fetch_blocks(const std::vector<index_t>& wanted) override {
+    const index_t n = m_.n, n3 = n * n * n;
+    const int fields = m_.mu_t.empty() ? 5 : 6;
+    lists recv(static_cast<std::size_t>(size_));
+    for (index_t b : wanted) {
+      require(b >= 0 && b < index_t(owner_.size()), "mpi::block_halo::fetch_blocks: no block ", b);
+      if (!computes(b)) recv[std::size_t(owner_[std::size_t(b)])].push_back(cell_ref{b, 0});
+    }
+    for (auto& items : recv) {
+      std::sort(items.begin(), items.end());
+      items.erase(std::unique(items.begin(), items.end()), items.end());
+    }
+    const lists send = requests_to_sends(recv);
+    // The interior cells of a block in (i, j, k) order, field by field.
+    const fluid::blocks::block_index at{n};
+    interior_.resize(std::size_t(n3));
+    for (index_t k = 0, o = 0; k < n; ++k)
+      for (index_t j = 0; j < n; ++j)
+        for (index_t i = 0; i < n; ++i) interior_[std::size_t(o++)] = at(i, j, k);
+    const auto before = count_;
+    begin(send, recv, int(fields * n3), block_at{this, n3});
+    end(recv, int(fields * n3), block_at{this, n3});
+    // Counted as moved blocks, not as a stage's messages (the communication model's).
+    count_.messages = before.messages;
+    count_.bytes = before.bytes;
+    std::int64_t got = 0;
+    for (const auto& items : recv) got += std::int64_t(items.size());
+    count_.fetched_blocks += got;
+    count_.fetched_bytes += got * std::int64_t(fields) * std::int64_t(n3) * std::int64_t(sizeof(double));
   }
 
   double max(double local) override {
@@ -264,6 +294,36 @@ class block_halo final : public fluid::blocks::halo {
 
  private:
   bool computes(index_t b) const noexcept { return everywhere_[std::size_t(b)] || owner_[std::size_t(b)] == rank_; }
+
+  /// The partition of `leaves` by `weight`: replicated blocks (with replicate_finest, the
+  /// finest level's), then the others' Morton order cut into one contiguous range per rank
+  /// (blocks::partition). rebuild and would_compute share it, so a regrid's forecast of its
+  /// new blocks is the partition it then gets.
+  void assign(const fluid::blocks::tree& leaves, const std::vector<double>& weight, std::vector<int>& owner,
+              std::vector<char>& everywhere, std::vector<std::vector<index_t>>& owned) const {
+    const index_t nb = leaves.size();
+    require(index_t(weight.size()) == nb, "mpi::block_halo: ", weight.size(), " block weights for ", nb, " blocks");
+    const int finest = leaves.finest_level();
+    everywhere.assign(std::size_t(nb), 0);
+    if (opt_.replicate_finest)
+      for (index_t b = 0; b < nb; ++b) everywhere[std::size_t(b)] = leaves.leaf(b).level == finest;
+    std::vector<index_t> spread;
+    std::vector<double> w;
+    for (index_t b = 0; b < nb; ++b)
+      if (!everywhere[std::size_t(b)]) {
+        spread.push_back(b);
+        w.push_back(weight[std::size_t(b)]);
+      }
+    const auto cut = spread.empty() ? std::vector<index_t>(std::size_t(size_) + 1, 0)
+                                    : fluid::blocks::partition(w, size_);
+    owner.assign(std::size_t(nb), 0);
+    owned.assign(std::size_t(size_), {});
+    for (int r = 0; r < size_; ++r)
+      for (index_t k = cut[std::size_t(r)]; k < cut[std::size_t(r) + 1]; ++k) {
+        owner[std::size_t(spread[std::size_t(k)])] = r;
+        owned[std::size_t(r)].push_back(spread[std::size_t(k)]);
+      }
+  }
 
   /// What each rank asks of this one, from what this one asks of each rank (recv[r]: the
   /// items it receives from r, in the order r must send them): MPI_Alltoall of the counts,
@@ -374,6 +434,18 @@ class block_halo final : public fluid::blocks::halo {
     double& operator()(const cell_ref& c, int) const { return h->m_.registers[std::size_t(c.block)][c.cell]; }
   };
 
+  /// A whole block's interior, field by field (fetch_blocks' storage; c.block the block,
+  /// value k the interior cell k % n³ of field k / n³, μ_t as the sixth).
+  struct block_at {
+    const block_halo* h;
+    index_t n3;
+    double& operator()(const cell_ref& c, int k) const {
+      const auto f = std::size_t(k / n3);
+      const index_t cell = h->interior_[std::size_t(k % n3)];
+      return f < 5 ? (*h->m_.U)[std::size_t(c.block)][f][cell] : h->m_.mu_t[std::size_t(c.block)][cell];
+    }
+  };
+
   /// One message per peer each way: post the receives, pack and send (begin); wait and
   /// unpack (end). width values per listed item, at(item, k) the storage of value k.
   template <class At>
@@ -432,6 +504,7 @@ class block_halo final : public fluid::blocks::halo {
   std::vector<double> gather_;
   std::vector<index_t> counts_, displs_, at_;  ///< allgather: values per rank, offsets; gather_items' cursor
   std::vector<int> mpi_counts_, mpi_displs_;
+  std::vector<index_t> interior_;  ///< fetch_blocks: a block's interior cells, (i, j, k) order
   std::vector<MPI_Request> reqs_;
   fluid::blocks::halo_counters count_;
 };

@@ -194,6 +194,9 @@ struct halo_counters {
   std::int64_t exchanges = 0;       ///< state exchanges (one per stage)
   std::int64_t gathers = 0;         ///< item gathers (gather_items: a coupling's cells and face records, per stage)
   std::int64_t gathered_bytes = 0;  ///< bytes they assembled on every process
+  std::int64_t state_gathers = 0;   ///< whole-state gathers (gather_state: output, checkpoints)
+  std::int64_t fetched_blocks = 0;  ///< blocks received by fetch_blocks (regrids, repartitions)
+  std::int64_t fetched_bytes = 0;   ///< bytes in them
 };
 
 /// The interface the block solver calls at the points of a stage where another process's
@@ -225,8 +228,17 @@ class halo {
   virtual void begin_registers() = 0;
   virtual void end_registers() = 0;
   /// Every block's interior cells (and eddy viscosity, with a closure) to every process
-  /// (before a regrid, a checkpoint, output).
+  /// (before a checkpoint or output).
   virtual void gather_state() = 0;
+  /// Which leaves of the mesh `leaves` with block costs `weight` this process would compute
+  /// (per leaf, 1 or 0) if rebuild were called with them: the same partition, without
+  /// adopting it (a regrid asks before it moves the state).
+  virtual std::vector<char> would_compute(const tree& leaves, const std::vector<double>& weight) const = 0;
+  /// The interior cells (and eddy viscosity, with a closure) of the listed blocks of the
+  /// present mesh from the processes computing them to this one; blocks this process
+  /// computes are left as they are. Every process passes its own list (collective): a
+  /// regrid or a new partition moves only what each process's new blocks are built from.
+  virtual void fetch_blocks(const std::vector<index_t>& wanted) = 0;
   /// The maximum of a value over the processes.
   virtual double max(double local) = 0;
   /// per_block holds `width` values per block, filled for the blocks this process computes:

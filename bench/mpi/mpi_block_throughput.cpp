@@ -4,8 +4,11 @@
 // (SSP-RK2, HLLC-LM + van Leer). Prints, from rank 0, the whole mesh's cell-updates per
 // second, and per rank and step the point-to-point messages and bytes the halo sent (its
 // own counters), the seconds spent in the exchange and in set_halo (the partition and the
-// exchange lists, as at every regrid; the slowest rank); with --check it also runs the same
-// steps on one process and counts the cells whose bits differ.
+// exchange lists, as at every regrid; the slowest rank); with --regrids K it then moves the
+// refined sphere K times by one root block along x and prints the seconds per regrid (the
+// slowest rank) and the bytes of state a rank received per regrid (halo::fetch_blocks);
+// with --check it also runs the same steps on one process and counts the cells whose bits
+// differ.
 //
 //   mpirun -np 2 build/release/bench/mpi/mpi_block_throughput --cells 64 --block-size 16 --steps 20
 #include <parafsi/fluid/block_solver.hpp>
@@ -30,6 +33,11 @@ pf::fluid::prim<double> smooth_field(const Eigen::Vector3d& x) {
           {0.3 * std::sin(tp * x[2]), 0.2 * std::cos(tp * x[0]), 0.1},
           1.0 + 0.1 * std::cos(tp * x[1])};
 }
+/// The state bytes a halo received for regrids (0 for a halo without that counter).
+double fetched_bytes(const auto& c) {
+  if constexpr (requires { c.fetched_bytes; }) return double(c.fetched_bytes);
+  else return 0.0;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -40,11 +48,14 @@ int main(int argc, char** argv) {
   CLI::App app{"Block-mesh throughput over MPI processes"};
   int n = 64, nb = 16, steps = 20;
   double sphere = 0.0;
+  int regrids = 0;
   bool check = false;
   app.add_option("--cells", n, "cells per box edge N (a multiple of the block size)")->check(CLI::Range(8, 1024));
   app.add_option("--block-size", nb, "cells per block edge N_b")->check(CLI::Range(4, 256));
   app.add_option("--steps", steps, "time steps to time")->check(CLI::Range(1, 100000));
   app.add_option("--refine-sphere", sphere, "refine the blocks meeting this sphere (box edges) about the centre once");
+  app.add_option("--regrids", regrids, "then move the refined sphere this many times and time the regrids")
+      ->check(CLI::Range(0, 1000));
   app.add_flag("--check", check, "also run on one process and count the cells that differ");
   CLI11_PARSE(app, argc, argv);
   if (n % nb != 0 || nb % 2 != 0) {
@@ -54,17 +65,24 @@ int main(int argc, char** argv) {
   pf::parallel::set_threads(1);
   const pf::index_t roots = n / nb;
   pf::fluid::blocks::tree tree({roots, roots, roots}, {true, true, true});
+  // Whether root block q (or the root block holding q) meets the sphere about (cx, ½, ½),
+  // periodic in x.
+  auto meets = [&](const pf::fluid::blocks::location& q, double cx) {
+    const double w = 1.0 / double(roots);
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double lo = double(q.l[std::size_t(d)] >> q.level) * w;
+      const double c0 = d == 0 ? cx : 0.5;
+      double c = std::clamp(c0, lo, lo + w) - c0;
+      if (d == 0)
+        c = std::min({std::fabs(c), std::fabs(std::clamp(c0 + 1.0, lo, lo + w) - c0 - 1.0),
+                      std::fabs(std::clamp(c0 - 1.0, lo, lo + w) - c0 + 1.0)});
+      d2 += c * c;
+    }
+    return d2 < sphere * sphere;
+  };
   if (sphere > 0.0)
-    tree.refine_where(1, [&](const pf::fluid::blocks::location& q) {
-      if (q.level > 0) return false;
-      double d2 = 0;
-      for (int d = 0; d < 3; ++d) {
-        const double lo = double(q.l[std::size_t(d)]) / double(roots), hi = lo + 1.0 / double(roots);
-        const double c = std::clamp(0.5, lo, hi) - 0.5;
-        d2 += c * c;
-      }
-      return d2 < sphere * sphere;
-    });
+    tree.refine_where(1, [&](const pf::fluid::blocks::location& q) { return q.level == 0 && meets(q, 0.5); });
   const pf::fluid::block_layout layout{{0, 0, 0}, {1, 1, 1}, {roots, roots, roots}, nb};
   auto make = [&] {
     auto s = std::make_unique<pf::fluid::block_solver<>>(tree, layout,
@@ -96,6 +114,23 @@ int main(int argc, char** argv) {
   MPI_Reduce(mine, sum, 3, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
   long owned = long(s->computed_blocks().size()), most = 0;
   MPI_Reduce(&owned, &most, 1, MPI_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
+  // Regrids: the refined sphere one root block further along x each time.
+  double regrid_s = 0.0, fetched = 0.0;
+  if (regrids > 0 && sphere > 0.0) {
+    const auto f0 = halo->counters();
+    MPI_Barrier(MPI_COMM_WORLD);
+    for (int k = 1; k <= regrids; ++k) {
+      const double cx = 0.5 + double(k) / double(roots);
+      const auto r0 = std::chrono::steady_clock::now();
+      s->regrid([&](const pf::fluid::blocks::location& q) { return meets(q, cx) ? 1 : 0; }, 1);
+      regrid_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+    }
+    regrid_s /= regrids;
+    MPI_Allreduce(MPI_IN_PLACE, &regrid_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    const auto f1 = halo->counters();
+    fetched = (fetched_bytes(f1) - fetched_bytes(f0)) / regrids;
+    MPI_Allreduce(MPI_IN_PLACE, &fetched, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  }
   long bad = -1;
   if (check) {
     s->gather();
@@ -122,6 +157,8 @@ int main(int argc, char** argv) {
         "exchange_s_per_step_max=%.4g halo_setup_s_max=%.4g",
         size, cells, long(s->block_count()), nb, s->tree().finest_level() + 1, steps, sec, cells * steps / sec, most,
         mx[0], sum[0] / size, mx[1], sum[1] / size, mx[2], setup);
+    if (regrids > 0 && sphere > 0.0)
+      std::printf(" regrids=%d regrid_s_max=%.4g regrid_fetched_bytes_per_rank_max=%.4g", regrids, regrid_s, fetched);
     if (check) std::printf(" cells_differing=%ld", bad);
     std::printf("\n");
   }

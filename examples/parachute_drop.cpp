@@ -191,6 +191,9 @@ int main(int argc, char** argv) {
   app.add_flag("--refine-column", c.refine_column,
                "blocks: also hold the finest level on the tensor box's refined column about the axis (from below "
                "the line confluence to above the crown)");
+  app.add_flag("--static-mesh", c.static_mesh,
+               "blocks: refine once at the start, to the canopy and the refined column as --refine-column, and "
+               "never regrid (the canopy must stay on that column)");
   app.add_option("--refine-vorticity", c.refine_vorticity,
                  "blocks: also refine the wake where |vorticity| h exceeds this fraction of the payload speed "
                  "(0: off)")

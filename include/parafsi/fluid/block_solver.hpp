@@ -1077,10 +1077,13 @@ class block_solver {
   /// stencil of two cells on the open side lies in that block's ghost layer), as on the box:
   /// the same values and corrections, to round-off, on one level.
   /// A recording patcher (patch.hpp) has its faces solved first, each on the process
-  /// computing its high cell, into one record per face (the fluxes, the patcher's value and
-  /// the rate changes), which every process then receives and replays in list order: the
-  /// patcher's sums, and the rates of the cells it computes. Any other patcher is called
-  /// face by face in list order by every process. Both give the bits of one process.
+  /// computing its high cell, which alone receives the cells the face reads (fetch_slots),
+  /// into one record per face (the fluxes, the patcher's value and the rate changes). Every
+  /// process receives every record's head and replays the patcher's sums in list order; a
+  /// whole record goes only to the processes computing a cell it changes, which replay it
+  /// onto those cells in list order (send_records). Any other patcher is called face by face
+  /// in list order by every process, with every face's cells on every process
+  /// (share_slots). Both give the bits of one process.
   template <class Patcher>
   void patch_faces(const detail::stage_geometry& geo, int stage, Patcher& patcher) {
     constexpr bool one_sided = detail::wants_one_sided<Patcher>() && Recon::second_order;
@@ -1101,8 +1104,15 @@ class block_solver {
     // Distributed: the cells the faces read come first from the processes computing them
     // (to every process: each solves the faces of its cells, or every face).
     if (halo_) {
-      patch_zone<one_sided>(faces, zone_);
-      share_slots(zone_, true);
+      if constexpr (recording_face_patcher<Patcher>) {
+        // Only to the process solving each face (the one computing its high cell).
+        patch_zone<one_sided>(faces, zone_,
+                              [&](std::size_t pi) { return computes_[std::size_t(faces[pi].high / stride_)] != 0; });
+        fetch_slots(zone_);
+      } else {
+        patch_zone<one_sided>(faces, zone_, [](std::size_t) { return true; });
+        share_slots(zone_, true);
+      }
     }
     if constexpr (one_sided) {
       if (blocked_.size() != std::size_t(stride_ * block_count()))
@@ -1178,9 +1188,12 @@ class block_solver {
   /// A solved face, as every process replays it (doubles; cell indices are exact):
   /// area, F, F_lo, F_hi, the patcher's value, the two cells and inverse widths, and up to
   /// two neighbouring-face changes (present, dF, ga, ixa, a_in, gb, ixb, b_in).
+  /// The first `head` values (area, F_lo, F_hi, the patcher's value) are what the patcher
+  /// records; every process receives them. The rest go to the processes computing the cells
+  /// they change.
   struct face_record {
-    static constexpr int area = 0, F = 1, lo = 6, hi = 11, value = 16, low = 17, ix_low = 18, high = 19, ix_high = 20,
-                         changes = 21, change_width = 12, width = changes + 2 * change_width;
+    static constexpr int area = 0, lo = 1, hi = 6, value = 11, head = 12, F = 12, low = 17, ix_low = 18, high = 19,
+                         ix_high = 20, changes = 21, change_width = 12, width = changes + 2 * change_width;
   };
 
   /// Solve the faces whose high cell this process computes (all of them without a halo)
@@ -1222,8 +1235,58 @@ class block_solver {
     if (halo_) {
       for (std::size_t m = 0; m < mine_.size(); ++m)  // each face's time to its high cell's block
         cost_[std::size_t(record_block_[std::size_t(mine_[m])])] += face_seconds_[m];
-      halo_->gather_items(record_block_, records_, W);
+      send_records();
     }
+  }
+
+  /// Distributed: every face's head (face_record::head values: what the patcher records)
+  /// to every process, from the process solving it; each whole record to the processes
+  /// computing a cell whose rate it changes (its low cell and the cells of its neighbouring-
+  /// face changes; all processes for a replicated block). held_ then lists, in list order,
+  /// the records this process replays onto its cells.
+  void send_records() {
+    constexpr int W = face_record::width, H = face_record::head;
+    const std::size_t count = record_block_.size();
+    heads_.assign(count * std::size_t(H), 0.0);
+    for (index_t pi : mine_) std::copy_n(records_.data() + std::size_t(pi) * W, H, heads_.data() + std::size_t(pi) * H);
+    halo_->gather_items(record_block_, heads_, H);
+    const int P = halo_->size(), me = halo_->rank();
+    out_.assign(std::size_t(P), {});
+    std::vector<char> to(static_cast<std::size_t>(P));
+    for (index_t pi : mine_) {
+      if (halo_->everywhere(record_block_[std::size_t(pi)])) continue;  // every process solved it
+      const double* r = records_.data() + std::size_t(pi) * W;
+      if (r[face_record::area] < 0.0) continue;  // failed: every process learns it from the heads
+      std::fill(to.begin(), to.end(), 0);
+      auto mark = [&](index_t g) {
+        if (g < 0) return;
+        const index_t b = g / stride_;
+        if (halo_->everywhere(b)) std::fill(to.begin(), to.end(), 1);
+        else to[std::size_t(halo_->owner(b))] = 1;
+      };
+      mark(index_t(r[face_record::low]));
+      for (int k = 0; k < 2; ++k) {
+        const double* c = r + face_record::changes + k * face_record::change_width;
+        if (c[0] == 0.0) continue;
+        if (c[8] != 0.0) mark(index_t(c[6]));
+        if (c[11] != 0.0) mark(index_t(c[9]));
+      }
+      for (int q = 0; q < P; ++q)
+        if (to[std::size_t(q)] && q != me) {
+          auto& o = out_[std::size_t(q)];
+          o.push_back(double(pi));
+          o.insert(o.end(), r, r + W);
+        }
+    }
+    halo_->exchange(out_, in_);
+    // This process's records and the received ones, in list order (a face is solved by one
+    // process, so no face arrives twice).
+    held_.clear();
+    for (index_t pi : mine_) held_.emplace_back(std::size_t(pi), records_.data() + std::size_t(pi) * W);
+    for (const auto& got : in_)
+      for (std::size_t o = 0; o < got.size(); o += std::size_t(W) + 1)
+        held_.emplace_back(std::size_t(got[o]), got.data() + o + 1);
+    std::sort(held_.begin(), held_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   }
 
   /// Face pi solved into its record r.
@@ -1259,35 +1322,46 @@ class block_solver {
 
   /// Every face's record in list order: the neighbouring-face changes, the patcher's sums,
   /// the face's own correction; rates only of the cells this process computes.
+  /// In two passes, which touch different sums: the patcher's, from every face's head in
+  /// list order (a failed face stops every process at the first one); then the rates of the
+  /// cells this process computes, from the records it holds in list order (all of them on
+  /// one process), so every cell gets its changes in the one-process order.
   template <class Patcher>
   void replay_faces(int stage, Patcher& patcher, std::size_t count, const detail::fields5<double>& dU) {
     constexpr int W = face_record::width;
-    auto here = [&](index_t g) { return g >= 0 && computes_[std::size_t(g / stride_)] != 0; };
+    const bool split = halo_ != nullptr;
+    const double* heads = split ? heads_.data() : records_.data();
+    const std::size_t hw = split ? std::size_t(face_record::head) : std::size_t(W);
     for (std::size_t pi = 0; pi < count; ++pi) {
-      const double* r = records_.data() + pi * std::size_t(W);
+      const double* r = heads + pi * hw;
       if (r[face_record::area] < 0.0) {  // the face's solver failed (solve_faces)
         if (failure_ && failed_at_ == pi) std::rethrow_exception(failure_);
         throw numerical_failure(parafsi::detail::concat("fluid::block_solver: patched face ", pi,
                                                         " failed on the process solving it (its message is there)"),
                                 long(pi), t_);
       }
+      face_context fc;
+      fc.stage = stage;
+      fc.patch = pi;
+      fc.area = r[face_record::area];
+      patcher.record_patch(fc, get(r + face_record::lo), get(r + face_record::hi), r[face_record::value]);
+    }
+    auto here = [&](index_t g) { return g >= 0 && computes_[std::size_t(g / stride_)] != 0; };
+    auto apply = [&](const double* r) {
       for (int k = 0; k < 2; ++k) {
         const double* c = r + face_record::changes + k * face_record::change_width;
         if (c[0] == 0.0) continue;
         const index_t ga = index_t(c[6]), gb = index_t(c[9]);
         detail::shift_face_change(c + 1, ga, c[7], c[8] != 0.0 && here(ga), gb, c[10], c[11] != 0.0 && here(gb), dU);
       }
-      face_context fc;
-      fc.stage = stage;
-      fc.patch = pi;
-      fc.area = r[face_record::area];
-      fc.low = index_t(r[face_record::low]);
-      fc.high = index_t(r[face_record::high]);
-      const cons<double> F = get(r + face_record::F), Flo = get(r + face_record::lo), Fhi = get(r + face_record::hi);
-      patcher.record_patch(fc, Flo, Fhi, r[face_record::value]);
-      detail::apply_face_patch(F, Flo, Fhi, fc.low, r[face_record::ix_low], here(fc.low), fc.high,
-                               r[face_record::ix_high], here(fc.high), dU);
-    }
+      const index_t low = index_t(r[face_record::low]), high = index_t(r[face_record::high]);
+      detail::apply_face_patch(get(r + face_record::F), get(r + face_record::lo), get(r + face_record::hi), low,
+                               r[face_record::ix_low], here(low), high, r[face_record::ix_high], here(high), dU);
+    };
+    if (split)
+      for (const auto& h : held_) apply(h.second);
+    else
+      for (std::size_t pi = 0; pi < count; ++pi) apply(records_.data() + pi * std::size_t(W));
   }
   static void put(double* o, const cons<double>& u) noexcept {
     o[0] = u.rho;
@@ -1304,8 +1378,8 @@ class block_solver {
   /// either side of it in its block's grid (the kernels' stencils), clipped to the grid;
   /// else the high cell's slots and the low cell (the patcher's view). Each once, in the
   /// order first met.
-  template <bool OneSided>
-  void patch_zone(std::span<const patch_face> faces, std::vector<index_t>& zone) {
+  template <bool OneSided, class Keep>
+  void patch_zone(std::span<const patch_face> faces, std::vector<index_t>& zone, Keep&& keep) {
     zone.clear();
     constexpr index_t ng = rectilinear_grid::ghosts;
     // Each slot once, in the order first met (the same on every process): a mark per slot
@@ -1327,26 +1401,71 @@ class block_solver {
       for (index_t g : zone) zone_mark_[std::size_t(g)] = 0;
     };
     try {
-      list_zone<OneSided>(faces, around, add);
+      list_zone<OneSided>(faces, around, add, keep);
     } catch (...) {
       unmark();  // a refused face (step_ref) leaves no marks behind
       throw;
     }
     unmark();
   }
-  template <bool OneSided, class Around, class Add>
-  void list_zone(std::span<const patch_face> faces, Around& around, Add& add) const {
-    for (const patch_face& f : faces) {
+  /// Every face is walked (step_ref refuses a level boundary beside a face alike on every
+  /// process); the slots of the faces keep(pi) accepts are listed.
+  template <bool OneSided, class Around, class Add, class Keep>
+  void list_zone(std::span<const patch_face> faces, Around& around, Add& add, Keep& keep) const {
+    for (std::size_t pi = 0; pi < faces.size(); ++pi) {
+      const patch_face& f = faces[pi];
       const index_t c = f.high;
       const int d = f.axis;
-      around(c / stride_, c % stride_, d);
+      const bool kept = keep(pi);
+      if (kept) around(c / stride_, c % stride_, d);
       if constexpr (OneSided) {
         const cell_ref hc{c / stride_, c % stride_,
                           blocks_[std::size_t(c / stride_)].grid.ijk(c % stride_)[std::size_t(d)], c};
         const cell_ref lc = step_ref(hc, d, 0), below = step_ref(lc, d, 0), above = step_ref(hc, d, 1);
-        for (const cell_ref& r : {lc, below, above}) around(r.id, r.local, d);
-      } else {
+        if (kept)
+          for (const cell_ref& r : {lc, below, above}) around(r.id, r.local, d);
+      } else if (kept) {
         add(neighbour(c, d, 0));
+      }
+    }
+  }
+
+  /// The conserved state and the stage's primitives at storage slots (block · stride +
+  /// local, ghosts included) from the processes computing their blocks to this one, which
+  /// reads them (collective; each process passes its own slots): one list of slots to each
+  /// owner, then their values back (halo::exchange twice). Slots of blocks this process
+  /// computes are left as they are.
+  void fetch_slots(const std::vector<index_t>& slots) {
+    const int P = halo_->size();
+    out_.assign(std::size_t(P), {});
+    for (index_t g : slots) {
+      const index_t id = g / stride_;
+      if (computes_[std::size_t(id)]) continue;
+      out_[std::size_t(halo_->owner(id))].push_back(double(g));  // exact below 2^53
+    }
+    std::vector<std::vector<double>> asks = out_, asked;
+    halo_->exchange(asks, asked);
+    const auto U = detail::conserved_ptrs(*U_);
+    const auto W = detail::primitive_ptrs(*W_);
+    for (int r = 0; r < P; ++r) {
+      auto& o = out_[std::size_t(r)];
+      o.clear();
+      for (double x : asked[std::size_t(r)]) {
+        const auto g = std::size_t(x);
+        for (int f = 0; f < 5; ++f) o.push_back(U[f][g]);
+        for (int f = 0; f < 5; ++f) o.push_back(W[f][g]);
+      }
+    }
+    halo_->exchange(out_, in_);
+    for (int r = 0; r < P; ++r) {
+      const auto& a = asks[std::size_t(r)];
+      const auto& v = in_[std::size_t(r)];
+      require(v.size() == 10 * a.size(), "fluid::block_solver: process ", r, " answered ", v.size() / 10, " of ",
+              a.size(), " cells");
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        const auto g = std::size_t(a[k]);
+        for (int f = 0; f < 5; ++f) U[f][g] = v[10 * k + std::size_t(f)];
+        for (int f = 0; f < 5; ++f) W[f][g] = v[10 * k + 5 + std::size_t(f)];
       }
     }
   }
@@ -1704,9 +1823,12 @@ class block_solver {
   std::vector<double> records_;                           ///< solve_faces: face_record::width per face
   std::vector<index_t> record_block_;                     ///< solve_faces: the block of each face's high cell
   std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves
-  std::size_t failed_at_ = 0;                             ///< solve_faces: the first face it failed to solve
-  std::exception_ptr failure_;                            ///< and that face's error
-  std::vector<std::uint8_t> zone_mark_;                   ///< patch_zone: slots already listed (all 0 between calls)
+  std::vector<double> heads_;                             ///< send_records: face_record::head per face
+  std::vector<std::vector<double>> out_, in_;             ///< halo::exchange lists (fetch_slots, send_records)
+  std::vector<std::pair<std::size_t, const double*>> held_;  ///< send_records: (face, record) this process replays
+  std::size_t failed_at_ = 0;                                ///< solve_faces: the first face it failed to solve
+  std::exception_ptr failure_;                               ///< and that face's error
+  std::vector<std::uint8_t> zone_mark_;                      ///< patch_zone: slots already listed (all 0 between calls)
   std::vector<double> share_vals_;
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;

@@ -21,9 +21,11 @@
 /// once the blocks whose registers other ranks read are swept (begin_registers) and travel while the solver sweeps the
 /// remaining blocks and corrects the coarse blocks whose corrections read only this rank's registers (end_registers
 /// waits). The reductions are MPI_Allreduce (max, exact) and MPI_Allgatherv of per-block values, added in block order
-/// by the caller. A coupling's items (gather_items: the cells the embedded coupling's faces read, then the records of
-/// the faces each process solved, each stage) travel by MPI_Allgatherv, each from the process computing its block, so
-/// every process replays every face alike. Results are therefore bitwise those of one process.
+/// by the caller. A coupling's items that every process needs (gather_items: the heads of the embedded coupling's face
+/// records, each stage) travel by MPI_Allgatherv, each from the process computing its block, so every process replays
+/// every face's load alike; what only some need (the cells a face reads, to its solver; a face's whole record, to the
+/// processes owning the cells it changes) by exchange(): an MPI_Alltoall of the counts, then point-to-point messages.
+/// Results are therefore bitwise those of one process.
 ///
 /// A regrid or a new partition moves no whole state: each process forecasts the blocks it
 /// will compute (would_compute, the same partition rebuild then makes) and fetches from
@@ -250,6 +252,37 @@ class block_halo final : public fluid::blocks::halo {
   }
 
   bool everywhere(index_t b) const override { return size_ == 1 || everywhere_[std::size_t(b)] != 0; }
+  int owner(index_t b) const override { return owner_[std::size_t(b)]; }
+
+  /// MPI_Alltoall of the counts, then MPI_Irecv/MPI_Isend per non-empty pair.
+  void exchange(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) override {
+    require(out.size() == std::size_t(size_), "mpi::block_halo::exchange: ", out.size(), " lists for ", size_,
+            " processes");
+    std::vector<long> give(static_cast<std::size_t>(size_)), take(static_cast<std::size_t>(size_));
+    for (int r = 0; r < size_; ++r) give[std::size_t(r)] = r == rank_ ? 0 : long(out[std::size_t(r)].size());
+    MPI_Alltoall(give.data(), 1, MPI_LONG, take.data(), 1, MPI_LONG, comm_);
+    in.assign(std::size_t(size_), {});
+    reqs_.clear();
+    for (int r = 0; r < size_; ++r) {
+      const long k = take[std::size_t(r)];
+      if (k == 0) continue;
+      require(k < 2000000000L, "mpi::block_halo::exchange: ", k, " values in one message");
+      in[std::size_t(r)].resize(std::size_t(k));
+      reqs_.emplace_back();
+      MPI_Irecv(in[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs_.back());
+    }
+    for (int r = 0; r < size_; ++r) {
+      const long k = give[std::size_t(r)];
+      if (k == 0) continue;
+      require(k < 2000000000L, "mpi::block_halo::exchange: ", k, " values in one message");
+      reqs_.emplace_back();
+      MPI_Isend(out[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs_.back());
+      count_.sparse_bytes += std::int64_t(k) * std::int64_t(sizeof(double));
+    }
+    MPI_Waitall(int(reqs_.size()), reqs_.data(), MPI_STATUSES_IGNORE);
+    reqs_.clear();
+    ++count_.sparse_exchanges;
+  }
 
   void gather_items(const std::vector<index_t>& item_block, std::vector<double>& values, int width) override {
     require(values.size() == item_block.size() * std::size_t(width), "mpi::block_halo::gather_items: ", values.size(),

@@ -108,6 +108,10 @@ struct drop_config {
   double refine_vorticity = 0;
   /// blocks: also hold the finest level on the tensor box's refined column (drop_column_target)
   bool refine_column = false;
+  /// blocks: refine once, at the start, to the canopy and the refined column (as
+  /// --refine-column's first mesh), and never regrid: a mesh that stays (the membrane must
+  /// stay on the column's finest level, or the coupling stops the run)
+  bool static_mesh = false;
   /// constant | inviscid | auto (constant with a closure; without one inviscid at draft/coarse/tiny)
   std::string viscosity = "auto";
   /// The wake's eddy-viscosity closure: none | mixing_length (Prandtl's, the method's,
@@ -197,6 +201,7 @@ struct drop_config {
     } else {
       require(refine_vorticity == 0, "parachute_drop: --refine-vorticity needs --mesh blocks");
       require(!refine_column, "parachute_drop: --refine-column needs --mesh blocks");
+      require(!static_mesh, "parachute_drop: --static-mesh needs --mesh blocks");
     }
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
@@ -388,6 +393,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
         .add("refine_every", std::int64_t(c.refine_every))
         .add("refine_vorticity", c.refine_vorticity)
         .add("refine_column", std::int64_t(c.refine_column));
+  if (c.mesh == "blocks" && c.static_mesh) g.add("static_mesh", std::int64_t(1));
   if (c.mesh == "blocks" && c.root_blocks != 2) g.add("root_blocks", std::int64_t(c.root_blocks));
   return g;
 }
@@ -526,7 +532,7 @@ class drop_run {
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
       if constexpr (block_mesh)
-        if (s_.steps() % c_.refine_every == 0) regrid();
+        if (!c_.static_mesh && s_.steps() % c_.refine_every == 0) regrid();
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
       update_wall_distance();
@@ -680,7 +686,7 @@ class drop_run {
       auto& f = s_.fluid();
       const auto canopy = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
                                             levels_, c_.refine_every);
-      const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column ? levels_ : 0);
+      const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column || c_.static_mesh ? levels_ : 0);
       const auto near = fluid::blocks::max_of{canopy, column};
       bool changed = false;
       if (c_.refine_vorticity > 0) {

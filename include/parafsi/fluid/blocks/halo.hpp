@@ -14,10 +14,11 @@
 ///     the prolongation stencils, blocks/exchange.hpp): `plan_reads` lists them;
 ///   - the face-register entries of finer blocks that its coarse blocks' flux corrections
 ///     read (blocks/flux_correction.hpp): `correction_reads`;
-///   - the cells a coupling's patched faces read (fluid::block_solver's share_slots: the
-///     stage's state and primitives around every face), and the records of the faces each
-///     process solved (solve_faces), gathered to every process so that each replays every
-///     face alike and the replicated structure gets the same loads;
+///   - the cells a coupling's patched faces read (fluid::block_solver's fetch_slots: the
+///     stage's state and primitives around a face, to the process solving it), the heads of
+///     the solved face records (gathered to every process, so the replicated structure gets
+///     the same loads) and the whole records (to the processes computing the cells they
+///     change; `exchange`);
 ///   - reductions: the stable step (a maximum, exact) and sums over the mesh, which are
 ///     formed per block and added in block order on every process, so that they do not
 ///     depend on the number of processes.
@@ -189,14 +190,16 @@ struct mesh_view {
 
 /// Message counters of a halo (its own bookkeeping, for the communication model).
 struct halo_counters {
-  std::int64_t messages = 0;        ///< point-to-point messages sent
-  std::int64_t bytes = 0;           ///< bytes in them
-  std::int64_t exchanges = 0;       ///< state exchanges (one per stage)
-  std::int64_t gathers = 0;         ///< item gathers (gather_items: a coupling's cells and face records, per stage)
-  std::int64_t gathered_bytes = 0;  ///< bytes they assembled on every process
-  std::int64_t state_gathers = 0;   ///< whole-state gathers (gather_state: output, checkpoints)
-  std::int64_t fetched_blocks = 0;  ///< blocks received by fetch_blocks (regrids, repartitions)
-  std::int64_t fetched_bytes = 0;   ///< bytes in them
+  std::int64_t messages = 0;          ///< point-to-point messages sent
+  std::int64_t bytes = 0;             ///< bytes in them
+  std::int64_t exchanges = 0;         ///< state exchanges (one per stage)
+  std::int64_t gathers = 0;           ///< item gathers (gather_items: the coupling's face heads per stage, share_cells)
+  std::int64_t gathered_bytes = 0;    ///< bytes they assembled on every process
+  std::int64_t state_gathers = 0;     ///< whole-state gathers (gather_state: output, checkpoints)
+  std::int64_t fetched_blocks = 0;    ///< blocks received by fetch_blocks (regrids, repartitions)
+  std::int64_t fetched_bytes = 0;     ///< bytes in them
+  std::int64_t sparse_exchanges = 0;  ///< exchange() calls (the embedded coupling's cells and records, per stage)
+  std::int64_t sparse_bytes = 0;      ///< bytes this process sent in them
 };
 
 /// The interface the block solver calls at the points of a stage where another process's
@@ -246,6 +249,13 @@ class halo {
   virtual void gather_blocks(std::vector<double>& per_block, int width) = 0;
   /// Whether every process computes block b (a replicated block).
   virtual bool everywhere(index_t b) const = 0;
+  /// The process computing partitioned block b (meaningless for a replicated block).
+  virtual int owner(index_t b) const = 0;
+  /// out[r] to process r, in[r] from process r, for every r (out[rank()] stays here and
+  /// in[rank()] is left empty): one count per pair, then a message where one is non-empty
+  /// (collective; each process passes its own lists). The embedded coupling's cells go to
+  /// the processes solving its faces and the solved records to those owning their cells.
+  virtual void exchange(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) = 0;
   /// Items held by blocks: item_block[i] is the block holding item i, values holds `width`
   /// values per item, filled for the items of the blocks this process owns (not the
   /// replicated ones): fill the others' from their owners; the items of replicated blocks

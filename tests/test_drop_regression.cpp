@@ -252,6 +252,7 @@ TEST_CASE("drop restart on blocks: a changed block-mesh parameter is refused by 
       {"refine_every", [](cfg& c) { c.refine_every = 3; }},
       {"refine_vorticity", [](cfg& c) { c.refine_vorticity = 0.2; }},
       {"refine_column", [](cfg& c) { c.refine_column = true; }},
+      {"static_mesh", [](cfg& c) { c.static_mesh = true; }},
       {"root_blocks", [](cfg& c) { c.root_blocks = 1; }},
       {"mesh", [](cfg& c) { c.mesh = "tensor"; }},
   };
@@ -303,6 +304,9 @@ TEST_CASE("drop config: silently dropped settings are refused by name") {
   c.root_blocks = 2;
   c.refine_every = 0;
   refused(c, "--refine-every must be >= 1 step, got 0");
+  c = cfg{};
+  c.static_mesh = true;
+  refused(c, "--static-mesh needs --mesh blocks");
 }
 
 // Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the

@@ -314,6 +314,31 @@ TEST_CASE("distributed block mesh: Smagorinsky eddy viscosity through levels and
     if (n == 4)
       CHECK(serial->regrid([&](const fb::location& q) { return vc.target(q); }, 2) ==
             dist->regrid([&](const fb::location& q) { return vc.target(q); }, 2));
+    if (n == 7) {
+      // A new cut of the mesh that stays: the blocks that change process bring their state
+      // and eddy viscosity (the next stable step reads μ_t) from their old owners. Rank 0's
+      // first block made expensive: it gets a process of its own, and the rest move.
+      const auto before = dist->computed_blocks();
+      if (world_rank() == 0 && !before.empty()) dist->add_block_cost(before.front(), 100.0);
+      const auto g0 = dist->halo()->counters();
+      dist->rebalance();
+      const auto g1 = dist->halo()->counters();
+      CHECK(g1.state_gathers == g0.state_gathers);
+      // Every block this process now computes holds the one-process eddy viscosity.
+      long mu_moved_bad = 0;
+      for (index_t b : dist->computed_blocks())
+        for (index_t k = 0; k < 8; ++k)
+          for (index_t j = 0; j < 8; ++j)
+            for (index_t i = 0; i < 8; ++i) {
+              const index_t c = dist->block_at(b).grid.index(i, j, k);
+              mu_moved_bad += serial->eddy_viscosity()[serial->global_index(b, c)] !=
+                              dist->eddy_viscosity()[dist->global_index(b, c)];
+            }
+      CHECK(mu_moved_bad == 0);
+      long moved = long(g1.fetched_blocks - g0.fetched_blocks);
+      MPI_Allreduce(MPI_IN_PLACE, &moved, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+      if (world_size() > 1) CHECK(moved > 0);
+    }
   }
   dist->gather();
   const long bad = mismatches(state_of(*serial), state_of(*dist));

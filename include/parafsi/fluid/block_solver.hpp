@@ -364,12 +364,14 @@ class block_solver {
   /// blocks are stale between `gather()` calls: call it before reading cells this process
   /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
   /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
-  /// A coupling reads and writes cells near the replicated structure. Each stage the cells
-  /// the patched faces read come from the processes computing them (share_slots); a
-  /// recording patcher's faces (coupling::embedded) are then solved each by the process
-  /// computing its high cell and replayed by every process in list order (another patcher's
-  /// are processed by every process), so the structure gets the same loads everywhere and
-  /// every cell its corrections in the same order. A
+  /// A coupling reads and writes cells near the replicated structure. A recording patcher's
+  /// faces (coupling::embedded) are solved each by the process computing its high cell,
+  /// which receives the cells the face reads (fetch_slots); every process adds every face's
+  /// load from its record's head in list order, and the processes computing the cells a
+  /// face changes replay its whole record in list order (send_records); another patcher's
+  /// faces are processed by every process, with every face's cells (share_slots). So the
+  /// structure gets the same loads everywhere and every cell its corrections in the same
+  /// order. A
   /// coupling that reads the air elsewhere (coupling::penalty's points) needs the blocks it
   /// touches computed by every process (mpi::block_halo's replicate_finest) and stops with a
   /// message otherwise. With an eddy-viscosity closure the wall distance is the caller's, on
@@ -426,7 +428,7 @@ class block_solver {
     halo_->fetch_blocks(wanted);
     weight_ = std::move(w);
     attach_halo();
-    require(forecast_ == computes_, "fluid::block_solver::rebalance: the partition differs from its forecast");
+    agree(forecast_ == computes_, "fluid::block_solver::rebalance: the partition differs from its forecast");
   }
   /// Every block's interior cells from its owner to every process (collective; a no-op
   /// when not distributed).
@@ -703,7 +705,8 @@ class block_solver {
     tree_ = std::move(next);
     weight_ = std::move(next_weight);  // the old mesh's costs, on the new leaves
     build();
-    require(!split || forecast_ == computes_,
+    if (split)
+      agree(forecast_ == computes_,
             "fluid::block_solver::regrid: the partition differs from its forecast (the halo's rebuild and "
             "would_compute must cut alike)");
     transfer(old, old_tree);
@@ -869,6 +872,12 @@ class block_solver {
   }
 
   /// f(), its seconds added to block id's measured cost when distributed (rebalance()).
+  /// Distributed: stop every process, not only this one, when `ok` fails on any (a shared
+  /// verdict, collective), so that none is left waiting in the next collective call.
+  void agree(bool ok, const char* what) const {
+    if ((halo_ && halo_->max(ok ? 0.0 : 1.0) > 0.0) || !ok) throw error(what);
+  }
+
   template <class F>
   void costed(index_t id, F&& f) {
     if (halo_) detail::timed(cost_[std::size_t(id)], f);
@@ -1185,9 +1194,9 @@ class block_solver {
 
   /// Faces solved on threads from this many on (below, waking threads costs more).
   static constexpr std::size_t threaded_faces = 64;
-  /// A solved face, as every process replays it (doubles; cell indices are exact):
-  /// area, F, F_lo, F_hi, the patcher's value, the two cells and inverse widths, and up to
-  /// two neighbouring-face changes (present, dF, ga, ixa, a_in, gb, ixb, b_in).
+  /// A solved face, as it is replayed (doubles; cell indices are exact): area, F_lo, F_hi,
+  /// the patcher's value, F, the two cells and inverse widths, and up to two
+  /// neighbouring-face changes (present, dF, ga, ixa, a_in, gb, ixb, b_in).
   /// The first `head` values (area, F_lo, F_hi, the patcher's value) are what the patcher
   /// records; every process receives them. The rest go to the processes computing the cells
   /// they change.
@@ -1197,7 +1206,8 @@ class block_solver {
   };
 
   /// Solve the faces whose high cell this process computes (all of them without a halo)
-  /// into face records, then bring the others' records from the processes solving them.
+  /// into face records, then share them (send_records: the heads with every process, the
+  /// whole records with the processes computing the cells they change).
   template <bool OneSided, class Patcher>
   void solve_faces(const detail::stage_geometry& geo, int stage, const Patcher& patcher,
                    std::span<const patch_face> faces, const fluid::view& state) {
@@ -1460,6 +1470,8 @@ class block_solver {
     for (int r = 0; r < P; ++r) {
       const auto& a = asks[std::size_t(r)];
       const auto& v = in_[std::size_t(r)];
+      // An internal invariant (an owner answers every slot asked of it, in order): a breach
+      // is a bug, stopped here on the process that sees it.
       require(v.size() == 10 * a.size(), "fluid::block_solver: process ", r, " answered ", v.size() / 10, " of ",
               a.size(), " cells");
       for (std::size_t k = 0; k < a.size(); ++k) {

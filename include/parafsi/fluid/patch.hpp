@@ -14,11 +14,13 @@
 /// (recording_face_patcher):
 ///   p.solve_patch(fc, view, lo, hi) → double  (const: the fluxes, and one number for ...)
 ///   p.record_patch(fc, lo, hi, value)         (... the patcher's own sums; reads fc.patch,
-///                                              fc.stage and fc.area only)
+///                                              fc.stage and fc.area only: the block mesh
+///                                              sets no other field of fc here)
 /// with patch() = record_patch(solve_patch()). The block mesh then solves the faces in
 /// parallel (threads, and on a mesh split over processes each face on the process computing
-/// its high cell, or on all where all compute it) and records them, and corrects the cells'
-/// rates, in list order on every process: the same bits as patch() face by face. A patcher without the split is called
+/// its high cell, or on all where all compute it) and records them in list order on every
+/// process, and each cell's rate is corrected in list order by the process computing it:
+/// the same bits as patch() face by face. A patcher without the split is called
 /// face by face in list order by every process. Either way, on a mesh split over processes
 /// the view is current only at each face's two cells (fc.low, fc.high): a patcher must read
 /// nothing else of the air.

@@ -97,7 +97,7 @@ struct halo_options {
   /// Every process computes the blocks of the finest level (when the mesh has more than
   /// one): the region where a coupling reads and writes the air when the structure lives on
   /// the finest level. coupling::penalty needs it; coupling::embedded does not (its faces'
-  /// cells are gathered each stage), and the drop splits every level with it. The other
+  /// cells travel to each face's solver each stage), and the drop splits every level with it. The other
   /// blocks are partitioned.
   bool replicate_finest = false;
 };
@@ -109,10 +109,19 @@ class block_halo final : public fluid::blocks::halo {
 
   using options = halo_options;
 
-  explicit block_halo(MPI_Comm comm = MPI_COMM_WORLD, halo_options o = halo_options{}) : comm_(comm), opt_(o) {
+  /// Works on a duplicate of `comm` (collective), so its messages never match the caller's.
+  explicit block_halo(MPI_Comm comm = MPI_COMM_WORLD, halo_options o = halo_options{}) : opt_(o) {
+    MPI_Comm_dup(comm, &comm_);
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
   }
+  ~block_halo() override {
+    int fin = 0;
+    MPI_Finalized(&fin);
+    if (!fin) MPI_Comm_free(&comm_);
+  }
+  block_halo(const block_halo&) = delete;
+  block_halo& operator=(const block_halo&) = delete;
 
   std::vector<index_t> rebuild(const fluid::blocks::mesh_view& m) override {
     m_ = m;
@@ -217,6 +226,13 @@ class block_halo final : public fluid::blocks::halo {
       items.erase(std::unique(items.begin(), items.end()), items.end());
     }
     const lists send = requests_to_sends(recv);
+    // Values per message (int counts): blocks × fields × n³, every process's verdict shared.
+    std::size_t largest = 0;
+    for (const lists* l : {static_cast<const lists*>(&recv), &send})
+      for (const auto& items : *l) largest = std::max(largest, items.size() * std::size_t(fields * n3));
+    MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_UNSIGNED_LONG, MPI_MAX, comm_);
+    require(largest < std::size_t(2000000000), "mpi::block_halo::fetch_blocks: ", largest,
+            " values in one message, more than 2000000000 (regrid more often or use more processes)");
     // The interior cells of a block in (i, j, k) order, field by field.
     const fluid::blocks::block_index at{n};
     interior_.resize(std::size_t(n3));
@@ -259,28 +275,34 @@ class block_halo final : public fluid::blocks::halo {
     require(out.size() == std::size_t(size_), "mpi::block_halo::exchange: ", out.size(), " lists for ", size_,
             " processes");
     std::vector<long> give(static_cast<std::size_t>(size_)), take(static_cast<std::size_t>(size_));
-    for (int r = 0; r < size_; ++r) give[std::size_t(r)] = r == rank_ ? 0 : long(out[std::size_t(r)].size());
+    long largest = 0;
+    for (int r = 0; r < size_; ++r) {
+      give[std::size_t(r)] = r == rank_ ? 0 : long(out[std::size_t(r)].size());
+      largest = std::max(largest, give[std::size_t(r)]);
+    }
+    // The limit of one message (int counts), checked with every process's verdict, so that
+    // all stop or none does.
+    MPI_Allreduce(MPI_IN_PLACE, &largest, 1, MPI_LONG, MPI_MAX, comm_);
+    require(largest < 2000000000L, "mpi::block_halo::exchange: a process sends ", largest,
+            " values in one message, more than 2000000000");
     MPI_Alltoall(give.data(), 1, MPI_LONG, take.data(), 1, MPI_LONG, comm_);
     in.assign(std::size_t(size_), {});
-    reqs_.clear();
+    std::vector<MPI_Request> reqs;  // its own: never the pending requests of a stage's exchange
     for (int r = 0; r < size_; ++r) {
       const long k = take[std::size_t(r)];
       if (k == 0) continue;
-      require(k < 2000000000L, "mpi::block_halo::exchange: ", k, " values in one message");
       in[std::size_t(r)].resize(std::size_t(k));
-      reqs_.emplace_back();
-      MPI_Irecv(in[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs_.back());
+      reqs.emplace_back();
+      MPI_Irecv(in[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs.back());
     }
     for (int r = 0; r < size_; ++r) {
       const long k = give[std::size_t(r)];
       if (k == 0) continue;
-      require(k < 2000000000L, "mpi::block_halo::exchange: ", k, " values in one message");
-      reqs_.emplace_back();
-      MPI_Isend(out[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs_.back());
+      reqs.emplace_back();
+      MPI_Isend(out[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs.back());
       count_.sparse_bytes += std::int64_t(k) * std::int64_t(sizeof(double));
     }
-    MPI_Waitall(int(reqs_.size()), reqs_.data(), MPI_STATUSES_IGNORE);
-    reqs_.clear();
+    MPI_Waitall(int(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
     ++count_.sparse_exchanges;
   }
 

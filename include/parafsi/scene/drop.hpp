@@ -440,6 +440,7 @@ class drop_run {
     emit(false);  // carried rows: those whose filter window is complete
     if constexpr (block_mesh) {
       if (c_.restart.empty()) regrid();
+      static_rebalance_at_ = s_.steps() + 5;
       res.cells = long(s_.fluid().cell_count());
     } else {
       const auto& g = s_.fluid().grid();
@@ -531,8 +532,11 @@ class drop_run {
     }
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
-      if constexpr (block_mesh)
+      if constexpr (block_mesh) {
         if (!c_.static_mesh && s_.steps() % c_.refine_every == 0) regrid();
+        else if (c_.static_mesh && s_.steps() == static_rebalance_at_)
+          s_.fluid().rebalance();  // a mesh that stays: cut once by the measured costs (over MPI)
+      }
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
       update_wall_distance();
@@ -794,7 +798,8 @@ class drop_run {
   std::optional<io::csv_writer> mesh_csv_;    ///< block mesh: mesh.csv
   std::vector<Eigen::Vector3d> wall_points_;  ///< mixing length: the structure's nodes in box coordinates
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
-  double cell_steps_ = 0;  ///< Σ over steps of the leaf cells
+  long static_rebalance_at_ = 0;  ///< --static-mesh: the step of its one cut by measured cost
+  double cell_steps_ = 0;         ///< Σ over steps of the leaf cells
   const drop_config& c_;
   const drop_setup& su_;
   stepper_type s_;

@@ -192,7 +192,7 @@ struct mesh_view {
 struct halo_counters {
   std::int64_t messages = 0;          ///< point-to-point messages sent
   std::int64_t bytes = 0;             ///< bytes in them
-  std::int64_t exchanges = 0;         ///< state exchanges (one per stage)
+  std::int64_t exchanges = 0;         ///< state exchanges (one per stage, one per vorticity_indicator)
   std::int64_t gathers = 0;           ///< item gathers (gather_items: the coupling's face heads per stage, share_cells)
   std::int64_t gathered_bytes = 0;    ///< bytes they assembled on every process
   std::int64_t state_gathers = 0;     ///< whole-state gathers (gather_state: output, checkpoints)

@@ -421,7 +421,7 @@ class block_solver {
     reattach_if_moved();
     std::vector<double> w = measured_weights(tree_, tree_);
     // The blocks this process takes over come from their present owners.
-    forecast_ = halo_->would_compute(tree_, w.empty() ? std::vector<double>(blocks_.size(), 1.0) : w);
+    forecast_ = halo_->would_compute(tree_, weights_or_uniform(w, blocks_.size()));
     std::vector<index_t> wanted;
     for (index_t id = 0; id < block_count(); ++id)
       if (forecast_[std::size_t(id)] && !computes_[std::size_t(id)]) wanted.push_back(id);
@@ -446,7 +446,7 @@ class block_solver {
     m.corrections = &corrections_;
     m.U = &U_all_;
     m.registers.resize(blocks_.size());
-    m.weight = weight_.size() == blocks_.size() ? weight_ : std::vector<double>(blocks_.size(), 1.0);
+    m.weight = weights_or_uniform(weight_, blocks_.size());
     for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces.data();
     if constexpr (has_eddy_viscosity) {
       m.mu_t.resize(blocks_.size());
@@ -872,6 +872,12 @@ class block_solver {
   }
 
   /// f(), its seconds added to block id's measured cost when distributed (rebalance()).
+  /// The partition's block weights: `w` when it has one per block, else 1 for every block
+  /// (nothing measured yet).
+  static std::vector<double> weights_or_uniform(const std::vector<double>& w, std::size_t blocks) {
+    return w.size() == blocks ? w : std::vector<double>(blocks, 1.0);
+  }
+
   /// Distributed: stop every process, not only this one, when `ok` fails on any (a shared
   /// verdict, collective), so that none is left waiting in the next collective call.
   void agree(bool ok, const char* what) const {
@@ -1261,8 +1267,9 @@ class block_solver {
     for (index_t pi : mine_) std::copy_n(records_.data() + std::size_t(pi) * W, H, heads_.data() + std::size_t(pi) * H);
     halo_->gather_items(record_block_, heads_, H);
     const int P = halo_->size(), me = halo_->rank();
-    out_.assign(std::size_t(P), {});
-    std::vector<char> to(static_cast<std::size_t>(P));
+    clear_lists(out_, P);
+    std::vector<char>& to = to_;
+    to.assign(std::size_t(P), 0);
     for (index_t pi : mine_) {
       if (halo_->everywhere(record_block_[std::size_t(pi)])) continue;  // every process solved it
       const double* r = records_.data() + std::size_t(pi) * W;
@@ -1440,6 +1447,12 @@ class block_solver {
     }
   }
 
+  /// `lists` with one empty list per process, keeping their capacity (no allocation per stage).
+  static void clear_lists(std::vector<std::vector<double>>& lists, int processes) {
+    lists.resize(std::size_t(processes));
+    for (auto& l : lists) l.clear();
+  }
+
   /// The conserved state and the stage's primitives at storage slots (block · stride +
   /// local, ghosts included) from the processes computing their blocks to this one, which
   /// reads them (collective; each process passes its own slots): one list of slots to each
@@ -1447,19 +1460,20 @@ class block_solver {
   /// computes are left as they are.
   void fetch_slots(const std::vector<index_t>& slots) {
     const int P = halo_->size();
-    out_.assign(std::size_t(P), {});
+    clear_lists(asks_, P);
     for (index_t g : slots) {
       const index_t id = g / stride_;
       if (computes_[std::size_t(id)]) continue;
-      out_[std::size_t(halo_->owner(id))].push_back(double(g));  // exact below 2^53
+      asks_[std::size_t(halo_->owner(id))].push_back(double(g));  // exact below 2^53
     }
-    std::vector<std::vector<double>> asks = out_, asked;
-    halo_->exchange(asks, asked);
+    halo_->exchange(asks_, asked_);
+    const auto& asks = asks_;
+    const auto& asked = asked_;
+    clear_lists(out_, P);
     const auto U = detail::conserved_ptrs(*U_);
     const auto W = detail::primitive_ptrs(*W_);
     for (int r = 0; r < P; ++r) {
       auto& o = out_[std::size_t(r)];
-      o.clear();
       for (double x : asked[std::size_t(r)]) {
         const auto g = std::size_t(x);
         for (int f = 0; f < 5; ++f) o.push_back(U[f][g]);
@@ -1614,7 +1628,7 @@ class block_solver {
   /// ghosts) are fetched from the processes computing them; then those leaves' ghosts are
   /// filled. Everything transfer() reads is then current here, and nothing else moves.
   void fetch_sources(const blocks::tree& next, const std::vector<double>& w) {
-    forecast_ = halo_->would_compute(next, w.empty() ? std::vector<double>(std::size_t(next.size()), 1.0) : w);
+    forecast_ = halo_->would_compute(next, weights_or_uniform(w, std::size_t(next.size())));
     std::vector<char> want(blocks_.size(), 0), prolonged(blocks_.size(), 0);
     auto under = [&](auto&& self, const blocks::location& o) -> void {
       const index_t oid = tree_.id_of(o);
@@ -1837,6 +1851,8 @@ class block_solver {
   std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves
   std::vector<double> heads_;                             ///< send_records: face_record::head per face
   std::vector<std::vector<double>> out_, in_;             ///< halo::exchange lists (fetch_slots, send_records)
+  std::vector<std::vector<double>> asks_, asked_;         ///< fetch_slots: the slots asked of / by each process
+  std::vector<char> to_;                                  ///< send_records: the processes a record goes to
   std::vector<std::pair<std::size_t, const double*>> held_;  ///< send_records: (face, record) this process replays
   std::size_t failed_at_ = 0;                                ///< solve_faces: the first face it failed to solve
   std::exception_ptr failure_;                               ///< and that face's error

@@ -274,7 +274,14 @@ class block_halo final : public fluid::blocks::halo {
   void exchange(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) override {
     require(out.size() == std::size_t(size_), "mpi::block_halo::exchange: ", out.size(), " lists for ", size_,
             " processes");
-    std::vector<long> give(static_cast<std::size_t>(size_)), take(static_cast<std::size_t>(size_));
+    // Member buffers (no allocation per stage once sized); the requests are not reqs_, so
+    // that a stage's pending exchange is never touched.
+    auto& give = give_;
+    auto& take = take_;
+    auto& reqs = xreqs_;
+    give.resize(std::size_t(size_));
+    take.resize(std::size_t(size_));
+    reqs.clear();
     long largest = 0;
     for (int r = 0; r < size_; ++r) {
       give[std::size_t(r)] = r == rank_ ? 0 : long(out[std::size_t(r)].size());
@@ -286,12 +293,11 @@ class block_halo final : public fluid::blocks::halo {
     require(largest < 2000000000L, "mpi::block_halo::exchange: a process sends ", largest,
             " values in one message, more than 2000000000");
     MPI_Alltoall(give.data(), 1, MPI_LONG, take.data(), 1, MPI_LONG, comm_);
-    in.assign(std::size_t(size_), {});
-    std::vector<MPI_Request> reqs;  // its own: never the pending requests of a stage's exchange
+    in.resize(std::size_t(size_));  // the lists keep their capacity
     for (int r = 0; r < size_; ++r) {
       const long k = take[std::size_t(r)];
-      if (k == 0) continue;
       in[std::size_t(r)].resize(std::size_t(k));
+      if (k == 0) continue;
       reqs.emplace_back();
       MPI_Irecv(in[std::size_t(r)].data(), int(k), MPI_DOUBLE, r, tag_ + 1, comm_, &reqs.back());
     }
@@ -561,6 +567,8 @@ class block_halo final : public fluid::blocks::halo {
   std::vector<int> mpi_counts_, mpi_displs_;
   std::vector<index_t> interior_;  ///< fetch_blocks: a block's interior cells, (i, j, k) order
   std::vector<MPI_Request> reqs_;
+  std::vector<long> give_, take_;   ///< exchange: values to and from each rank
+  std::vector<MPI_Request> xreqs_;  ///< exchange: its requests
   fluid::blocks::halo_counters count_;
 };
 

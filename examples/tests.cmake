@@ -368,7 +368,7 @@ endif()
 
 # ---- The drop over MPI processes (docs/guide_mpi.md): the tiny block-mesh drop for 0.05 s
 #      on one process without mpirun, then under mpiexec on N processes: history.csv,
-#      summary.csv and mesh.csv must be the same bytes. With N = 2 also a checkpoint
+#      summary.csv, mesh.csv and the mid-plane slice must be the same bytes. With N = 2 also a checkpoint
 #      written at 0.03 s by 2 processes, restarted on 4 and on 1 (no mpirun): the same
 #      history.csv again.
 if(TARGET parafsi::mpi)
@@ -393,9 +393,11 @@ function(same a b)
   endforeach()
   message("${b}: ${ARGN} identical to ${a}")
 endfunction()
-run("one process" ${PROGRAM} ${ARGS} --t-end 0.05 --vtk-every 0.025 --out ${OUT}/one)
-run("${NP} processes" ${MPI} ${NP} ${FLAGS} ${PROGRAM} ${ARGS} --t-end 0.05 --vtk-every 0.025 --out ${OUT}/np${NP})
-same(${OUT}/one ${OUT}/np${NP} history.csv summary.csv mesh.csv)
+run("one process" ${PROGRAM} ${ARGS} --t-end 0.05 --vtk-every 0.025 --slice-times 0.025 --out ${OUT}/one)
+run("${NP} processes" ${MPI} ${NP} ${FLAGS} ${PROGRAM} ${ARGS} --t-end 0.05 --vtk-every 0.025 --slice-times 0.025
+    --out ${OUT}/np${NP})
+# The slice reads the blocks the mid-plane cuts, fetched to the writing process only.
+same(${OUT}/one ${OUT}/np${NP} history.csv summary.csv mesh.csv slice_00.025.csv)
 # VTK: one .vtu per instant from one process; from N > 1 a .pvtu index naming N pieces, each written.
 file(GLOB one_vtu ${OUT}/one/vtk/fluid_*.vtu)
 list(LENGTH one_vtu n_one)

@@ -8,7 +8,9 @@
 // refined sphere K times by one root block along x and prints the seconds per regrid (the
 // slowest rank) and the bytes of state a rank received per regrid (halo::fetch_blocks);
 // with --check it also runs the same steps on one process and counts the cells whose bits
-// differ.
+// differ. It prints the resident and peak memory of the largest rank: each process builds
+// only the blocks it computes (the solver made with the halo); --whole-then-split builds the
+// whole mesh on every process first and splits it (set_halo).
 //
 //   mpirun -np 2 build/release/bench/mpi/mpi_block_throughput --cells 64 --block-size 16 --steps 20
 #include <parafsi/fluid/block_solver.hpp>
@@ -20,8 +22,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace pf = parafsi;
@@ -38,6 +43,14 @@ double fetched_bytes(const auto& c) {
   if constexpr (requires { c.fetched_bytes; }) return double(c.fetched_bytes);
   else return 0.0;
 }
+/// A memory line of /proc/self/status in MiB (−1 where there is none).
+double status_mib(const char* key) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(key, 0) == 0) return std::stod(line.substr(std::strlen(key))) / 1024.0;  // kB
+  return -1.0;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,7 +62,7 @@ int main(int argc, char** argv) {
   int n = 64, nb = 16, steps = 20;
   double sphere = 0.0;
   int regrids = 0;
-  bool check = false;
+  bool check = false, whole = false;
   app.add_option("--cells", n, "cells per box edge N (a multiple of the block size)")->check(CLI::Range(8, 1024));
   app.add_option("--block-size", nb, "cells per block edge N_b")->check(CLI::Range(4, 256));
   app.add_option("--steps", steps, "time steps to time")->check(CLI::Range(1, 100000));
@@ -57,6 +70,9 @@ int main(int argc, char** argv) {
   app.add_option("--regrids", regrids, "then move the refined sphere this many times and time the regrids")
       ->check(CLI::Range(0, 1000));
   app.add_flag("--check", check, "also run on one process and count the cells that differ");
+  app.add_flag("--whole-then-split", whole,
+               "build and initialize the whole mesh on every process, then split it (set_halo); by default each "
+               "process builds its own blocks only (the solver made with the halo)");
   CLI11_PARSE(app, argc, argv);
   if (n % nb != 0 || nb % 2 != 0) {
     if (rank == 0) std::fprintf(stderr, "mpi_block_throughput: the block size must be even and divide --cells\n");
@@ -84,14 +100,14 @@ int main(int argc, char** argv) {
   if (sphere > 0.0)
     tree.refine_where(1, [&](const pf::fluid::blocks::location& q) { return q.level == 0 && meets(q, 0.5); });
   const pf::fluid::block_layout layout{{0, 0, 0}, {1, 1, 1}, {roots, roots, roots}, nb};
-  auto make = [&] {
-    auto s = std::make_unique<pf::fluid::block_solver<>>(tree, layout,
-                                                         pf::boundary::set::all(pf::boundary::periodic{}));
+  auto make = [&](std::shared_ptr<pf::mpi::block_halo> h = {}) {
+    auto s = std::make_unique<pf::fluid::block_solver<>>(tree, layout, pf::boundary::set::all(pf::boundary::periodic{}),
+                                                         h);
     s->initialize(smooth_field);
     return s;
   };
-  auto s = make();
   auto halo = std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD);
+  auto s = make(whole ? nullptr : halo);
   MPI_Barrier(MPI_COMM_WORLD);
   const auto h0 = std::chrono::steady_clock::now();
   s->set_halo(halo);  // the partition and the exchange lists (as at every regrid)
@@ -114,6 +130,9 @@ int main(int argc, char** argv) {
   MPI_Reduce(mine, sum, 3, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
   long owned = long(s->computed_blocks().size()), most = 0;
   MPI_Reduce(&owned, &most, 1, MPI_LONG, MPI_MAX, 0, MPI_COMM_WORLD);
+  // Resident and peak memory of the process (Linux: /proc/self/status), the largest over ranks.
+  double mem[2] = {status_mib("VmRSS:"), status_mib("VmHWM:")}, mem_max[2];
+  MPI_Reduce(mem, mem_max, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   // Regrids: the refined sphere one root block further along x each time.
   double regrid_s = 0.0, fetched = 0.0;
   if (regrids > 0 && sphere > 0.0) {
@@ -154,9 +173,11 @@ int main(int argc, char** argv) {
         "mpi_block_throughput ranks=%d cells=%.0f blocks=%ld block=%d levels=%d steps=%d seconds=%.4g "
         "cell_updates_per_s=%.4g blocks_per_rank_max=%ld messages_per_rank_step_max=%.3g "
         "messages_per_rank_step_mean=%.3g bytes_per_rank_step_max=%.4g bytes_per_rank_step_mean=%.4g "
-        "exchange_s_per_step_max=%.4g halo_setup_s_max=%.4g",
+        "exchange_s_per_step_max=%.4g halo_setup_s_max=%.4g resident_mib_per_rank_max=%.1f "
+        "peak_mib_per_rank_max=%.1f resident_bytes_per_mesh_cell=%.1f",
         size, cells, long(s->block_count()), nb, s->tree().finest_level() + 1, steps, sec, cells * steps / sec, most,
-        mx[0], sum[0] / size, mx[1], sum[1] / size, mx[2], setup);
+        mx[0], sum[0] / size, mx[1], sum[1] / size, mx[2], setup, mem_max[0], mem_max[1],
+        mem_max[0] * 1048576.0 / cells);
     if (regrids > 0 && sphere > 0.0)
       std::printf(" regrids=%d regrid_s_max=%.4g regrid_fetched_bytes_per_rank_max=%.4g", regrids, regrid_s, fetched);
     if (check) std::printf(" cells_differing=%ld", bad);

@@ -9,12 +9,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <parafsi/fluid/block_solver.hpp>
 #include <parafsi/fluid/reference/vortices.hpp>
+#include <parafsi/io/block_vtk.hpp>
 #include <parafsi/io/checkpoint.hpp>
 #include <parafsi/mpi/block_halo.hpp>
 
@@ -247,20 +250,57 @@ TEST_CASE("distributed block mesh: viscous air, far field and sponge on a refine
   auto serial = make();
   auto dist = make();
   dist->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  // Split from its construction: each process fills and initializes only its own blocks.
+  using lean_solver = fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::van_leer>,
+                                          pf::turbulence::none, pf::viscosity::constant, pf::frame::rigid>;
+  auto lean = std::make_unique<lean_solver>(t0, box, bc, std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD), motion,
+                                            pf::viscosity::constant{0.05, 0.72});
+  lean->initialize([&](const Eigen::Vector3d& x) {
+    const double r2 = (x - Eigen::Vector3d(0.1, 0.0, 0.2)).squaredNorm();
+    return fluid::prim<double>{rho0 * (1.0 + 0.2 * std::exp(-r2 / 0.02)),
+                               {30.0, 0.0, 0.0},
+                               p0 * (1.0 + 0.3 * std::exp(-r2 / 0.02))};
+  });
+  // Blocks holding any state on this process: split, only its own and those its ghost
+  // plans read (the halo's), the rest zero; for the split solver the same after set_halo.
+  auto holding = [](const auto& s) {
+    long held = 0;
+    for (index_t id = 0; id < s.block_count(); ++id) {
+      const auto& b = s.block_at(id);
+      const double* rho = b.U.data(0);
+      bool any = false;
+      for (index_t c = 0; c < s.stride() && !any; ++c) any = rho[c] != 0.0;
+      held += any;
+    }
+    return held;
+  };
   int dt_differ = 0;
   for (int n = 0; n < 12; ++n) {
-    const double dts = serial->stable_dt(0.5), dtd = dist->stable_dt(0.5);
-    dt_differ += dts != dtd;
+    const double dts = serial->stable_dt(0.5), dtd = dist->stable_dt(0.5), dtl = lean->stable_dt(0.5);
+    dt_differ += (dts != dtd) + (dts != dtl);
     serial->step(dts);
     dist->step(dtd);
+    lean->step(dtl);
   }
+  const long held_dist = holding(*dist), held_lean = holding(*lean);
+  long held_most = std::max(held_dist, held_lean);
+  MPI_Allreduce(MPI_IN_PLACE, &held_most, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
   dist->gather();
+  lean->gather();
   const long bad = mismatches(state_of(*serial), state_of(*dist));
+  const long bad_lean = mismatches(state_of(*serial), state_of(*lean));
   if (world_rank() == 0)
-    MESSAGE(world_size(), " processes, ", dist->block_count(), " blocks: cells differing from one process: ", bad);
+    MESSAGE(world_size(), " processes, ", dist->block_count(), " blocks: cells differing from one process: ", bad,
+            " (split after construction), ", bad_lean,
+            " (split from construction); blocks holding state on a process: ", held_most);
   CHECK(dt_differ == 0);
   CHECK(bad == 0);
+  CHECK(bad_lean == 0);
   CHECK(same_totals(serial->totals(), dist->totals()));
+  CHECK(same_totals(serial->totals(), lean->totals()));
+  // One process holds every block; split, a process holds fewer (the rest cost no memory).
+  if (world_size() == 1) CHECK(held_most == serial->block_count());
+  else CHECK(held_most < serial->block_count());
 }
 
 namespace {
@@ -613,4 +653,74 @@ TEST_CASE("cost-weighted partition: measured block costs cut the mesh at regrids
   dist->gather();
   CHECK(mismatches(state_of(*serial), state_of(*dist)) == 0);
   CHECK(same_totals(serial->totals(), dist->totals()));
+}
+
+TEST_CASE("distributed output: a VTK piece and a checkpoint from the blocks fetched for them, as from a whole gather") {
+  using S = fluid::block_solver<pf::flux::hllc_lm, pf::recon::muscl<pf::limiter::van_leer>, pf::turbulence::smagorinsky,
+                                pf::viscosity::constant>;
+  const vortex_case vc;
+  const pf::viscosity::constant air{0.02, 0.72};
+  auto s = vc.make<S>(pf::turbulence::smagorinsky{}, air);
+  s->set_halo(std::make_shared<pf::mpi::block_halo>(MPI_COMM_WORLD));
+  for (int n = 0; n < 4; ++n) s->step(s->stable_dt(0.5));
+  const int r = world_rank(), P = world_size();
+  const auto dir = std::filesystem::temp_directory_path() / ("parafsi_test_mpi_out_np" + std::to_string(P));
+  if (r == 0) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir / "fetched");
+    std::filesystem::create_directories(dir / "gathered");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  auto bytes = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  // A piece's blocks and their face neighbours (the vorticity reads those), then freed.
+  const auto range = pf::io::piece_blocks(s->block_count(), r, P);
+  std::vector<index_t> piece;
+  for (index_t id = range.first; id < range.last; ++id) piece.push_back(id);
+  s->fetch(s->with_face_neighbours(piece));
+  pf::io::write_pvtu_piece(dir / "fetched" / "f.pvtu", *s, {}, r, P);
+  s->release_fetched();
+  // The checkpoint from the whole mesh on process 0 only.
+  s->gather_to(0);
+  if (r == 0) pf::io::save_checkpoint(dir / "fetched" / "c.ckpt", *s);
+  s->release_fetched();
+  // Blocks with state after the release: a split process holds fewer than the mesh.
+  long held = 0;
+  for (index_t id = 0; id < s->block_count(); ++id) {
+    const double* rho = s->block_at(id).U.data(0);
+    bool any = false;
+    for (index_t c = 0; c < s->stride() && !any; ++c) any = rho[c] != 0.0;
+    held += any;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &held, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+  // The same files after a whole-state gather.
+  s->gather();
+  pf::io::write_pvtu_piece(dir / "gathered" / "f.pvtu", *s, {}, r, P);
+  if (r == 0) pf::io::save_checkpoint(dir / "gathered" / "c.ckpt", *s);
+  MPI_Barrier(MPI_COMM_WORLD);
+  const std::string name = "f_" + std::to_string(r) + ".vtu";
+  long differ = bytes(dir / "fetched" / name) != bytes(dir / "gathered" / name);
+  if (r == 0) differ += bytes(dir / "fetched" / "c.ckpt") != bytes(dir / "gathered" / "c.ckpt");
+  if (r == 0) differ += bytes(dir / "fetched" / "c.ckpt").empty();
+  MPI_Allreduce(MPI_IN_PLACE, &differ, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  if (r == 0)
+    MESSAGE(P, " processes, ", s->block_count(), " blocks: output files differing from the whole gather's: ", differ,
+            "; blocks holding state on a process after release_fetched: ", held);
+  CHECK(differ == 0);
+  if (P == 1) CHECK(held == s->block_count());
+  else CHECK(held < s->block_count());
+  // Stepping on after the release stays bitwise (the serial reference).
+  auto serial = vc.make<S>(pf::turbulence::smagorinsky{}, air);
+  for (int n = 0; n < 4; ++n) serial->step(serial->stable_dt(0.5));
+  for (int n = 0; n < 3; ++n) {
+    s->release_fetched();
+    s->step(s->stable_dt(0.5));
+    serial->step(serial->stable_dt(0.5));
+  }
+  s->gather();
+  CHECK(mismatches(state_of(*serial), state_of(*s)) == 0);
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (r == 0) std::filesystem::remove_all(dir);
 }

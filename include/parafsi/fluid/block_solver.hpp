@@ -102,11 +102,14 @@ class block_solver {
   /// Eddy viscosity (and the mixing length's wall distance) per cell, mesh-wide like U.
   using turbulence_storage = std::conditional_t<
       has_eddy_viscosity,
-      std::conditional_t<needs_wall_distance, soa<field::mu_t, field::wall_distance>, soa<field::mu_t>>, empty_storage>;
+      std::conditional_t<needs_wall_distance, paged_soa<field::mu_t, field::wall_distance>, paged_soa<field::mu_t>>,
+      empty_storage>;
   static constexpr index_t ng = rectilinear_grid::ghosts;
-  using cons_storage = soa_of_t<conserved_fields>;
-  using prim_storage = soa_of_t<primitive_fields>;
-  using source_storage = soa_of_t<source_fields>;
+  // Mesh-wide fields in paged storage (core/soa.hpp): zero when made, memory only where
+  // written, so a process of a distributed run pays for the blocks it holds.
+  using cons_storage = paged_soa_of_t<conserved_fields>;
+  using prim_storage = paged_soa_of_t<primitive_fields>;
+  using source_storage = paged_soa_of_t<source_fields>;
   /// io::save_checkpoint / load_checkpoint store the block mesh in this section.
   static constexpr const char* checkpoint_section = "fluid_blocks";
 
@@ -142,6 +145,14 @@ class block_solver {
 
   template <policy... Ps>
   block_solver(blocks::tree tree, block_layout layout, boundary::set bc, const Ps&... policies)
+      : block_solver(std::move(tree), layout, std::move(bc), std::shared_ptr<blocks::halo>{}, policies...) {}
+
+  /// Split over processes from the start (see set_halo): each process allocates, fills and
+  /// initializes only the blocks it computes, so none ever holds the whole mesh; a mesh
+  /// made whole and then split (set_halo) holds it until the split. Collective.
+  template <policy... Ps>
+  block_solver(blocks::tree tree, block_layout layout, boundary::set bc, std::shared_ptr<blocks::halo> h,
+               const Ps&... policies)
       : tree_(std::move(tree)),
         layout_(layout),
         bc_(std::move(bc)),
@@ -167,8 +178,10 @@ class block_solver {
               " but the layout ", layout_.root_blocks[std::size_t(d)]);
     }
     sponge_target_ = detail::sponge_target(bc_, gas_, sponge_target_);
+    halo_ = std::move(h);
     build();
     fill_uniform({1.18, {0.0, 0.0, 0.0}, 101325.0});
+    gathered_ = !split();
   }
 
   block_solver(const block_solver&) = delete;  // blocks point into the solver's storage
@@ -181,12 +194,18 @@ class block_solver {
     validate_state(w, "fill_uniform");
     const cons<double> q = to_cons(w, gas_);
     const auto U = detail::conserved_ptrs(*U_);
-    for (index_t c = 0; c < U_->size() + index_t(simd::width); ++c) detail::store_cons(U, c, q);
+    if (!split()) {
+      for (index_t c = 0; c < U_->size() + index_t(simd::width); ++c) detail::store_cons(U, c, q);
+      return;
+    }
+    for (index_t id : computed_)  // split: the blocks this process computes
+      for (index_t c = stride_ * id; c < stride_ * (id + 1); ++c) detail::store_cons(U, c, q);
   }
-  /// Initialise every leaf cell from f(ξ) → prim<double> (ξ: cell centre, box coordinates).
+  /// Initialise every leaf cell from f(ξ) → prim<double> (ξ: cell centre, box coordinates);
+  /// split over processes, the cells of the blocks this process computes.
   template <class F>
   void initialize(F&& f) {
-    for_each_cell([&](block& b, index_t i, index_t j, index_t k) {
+    for_each_own_cell([&](block& b, index_t i, index_t j, index_t k) {
       const Eigen::Vector3d xi{b.grid.centre(0, i), b.grid.centre(1, j), b.grid.centre(2, k)};
       const prim<double> w = f(xi);
       validate_state(w, "initialize");
@@ -197,7 +216,7 @@ class block_solver {
   template <class F>
   void initialize_averaged(F&& f, int m) {
     require(m >= 1, "initialize_averaged: need m >= 1");
-    for_each_cell([&](block& b, index_t i, index_t j, index_t k) {
+    for_each_own_cell([&](block& b, index_t i, index_t j, index_t k) {
       const auto& g = b.grid;
       cons<double> acc{0, {0, 0, 0}, 0};
       for (int c = 0; c < m; ++c)
@@ -213,6 +232,18 @@ class block_solver {
       detail::store_cons(detail::conserved_ptrs(b.U), g.index(i, j, k), acc * (1.0 / double(m * m * m)));
     });
   }
+  /// f(block, i, j, k) over every leaf cell of the blocks this process computes (all of
+  /// them when not split), blocks in tree order.
+  template <class F>
+  void for_each_own_cell(F&& f) {
+    if (!split()) return for_each_cell(f);
+    for (index_t id : computed_)
+      for (index_t k = 0; k < n_; ++k)
+        for (index_t j = 0; j < n_; ++j)
+          for (index_t i = 0; i < n_; ++i) f(blocks_[std::size_t(id)], i, j, k);
+  }
+  /// Whether the mesh is split over more than one process.
+  bool split() const noexcept { return halo_ && halo_->size() > 1; }
   /// f(block, i, j, k) over every leaf cell, blocks in tree order.
   template <class F>
   void for_each_cell(F&& f) {
@@ -360,10 +391,13 @@ class block_solver {
   /// Split the mesh over processes (blocks/halo.hpp; mpi/block_halo.hpp over MPI): from now
   /// on this process computes only its blocks [first, last) and `h` brings what they read of
   /// the others'. Every process must hold the same mesh and state when this is called, and
-  /// make the same calls after it (stepping, stable_dt, totals, regrid, gather). The others'
-  /// blocks are stale between `gather()` calls: call it before reading cells this process
-  /// does not own (sample, for_each_cell, output) and before writing a checkpoint (from one
-  /// process; a checkpoint holds the whole mesh, so any number of processes can read it).
+  /// make the same calls after it (stepping, stable_dt, totals, regrid, fetch, gather). The
+  /// others' blocks are stale or zero: bring them before reading cells this process does
+  /// not own (sample, for_each_cell, output) with fetch (the blocks it will read), gather
+  /// (every block, every process) or gather_to (every block, one process: before it writes
+  /// a checkpoint, which holds the whole mesh, so any number of processes can read it), and
+  /// free them with release_fetched. This call copies the blocks the process holds into new
+  /// arrays (paged storage) and frees the rest; a solver made with the halo never holds them.
   /// A coupling reads and writes cells near the replicated structure. A recording patcher's
   /// faces (coupling::embedded) are solved each by the process computing its high cell,
   /// which receives the cells the face reads (fetch_slots); every process adds every face's
@@ -381,6 +415,10 @@ class block_solver {
     weight_.clear();   // a new split: uniform until costs are measured
     gathered_ = true;  // the caller's promise: every process holds the same state
     attach_halo();
+    if (halo_ && halo_->size() > 1) {
+      keep_held_storage();
+      attach_halo();  // the halo reads the new arrays
+    }
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
   /// Whether every process computes block id (always, when not distributed).
@@ -425,6 +463,7 @@ class block_solver {
     std::vector<index_t> wanted;
     for (index_t id = 0; id < block_count(); ++id)
       if (forecast_[std::size_t(id)] && !computes_[std::size_t(id)]) wanted.push_back(id);
+    for (index_t id : wanted) initialize_block_storage(id);  // its ghosts; the fetch brings its cells
     halo_->fetch_blocks(wanted);
     weight_ = std::move(w);
     attach_halo();
@@ -436,6 +475,86 @@ class block_solver {
     reattach_if_moved();
     if (halo_ && halo_->size() > 1) halo_->gather_state();
     gathered_ = true;
+  }
+  /// The listed blocks' interior cells (and eddy viscosity, with a closure) from the
+  /// processes computing them to this one (collective; each process lists the blocks it is
+  /// about to read, e.g. a VTK piece's blocks and their face neighbours, or those a slice
+  /// cuts). Unlike gather() it brings only those, so the process stays backed for its own
+  /// blocks and these; release_fetched() frees them again. A no-op when not split.
+  void fetch(const std::vector<index_t>& ids) {
+    if (!split()) return;
+    reattach_if_moved();
+    std::vector<index_t> wanted;
+    for (index_t id : ids) {
+      require(id >= 0 && id < block_count(), "fluid::block_solver::fetch: no block ", id);
+      if (!computes_[std::size_t(id)]) wanted.push_back(id);
+    }
+    std::sort(wanted.begin(), wanted.end());
+    wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+    halo_->fetch_blocks(wanted);
+    gathered_ = false;
+  }
+  /// Every block's interior cells to process `rank` only (collective): before that process
+  /// writes a checkpoint (the whole mesh on it, the others unchanged).
+  void gather_to(int rank) {
+    if (!split()) {
+      gathered_ = true;  // one process holds every block
+      return;
+    }
+    std::vector<index_t> all;
+    if (halo_->rank() == rank)
+      for (index_t id = 0; id < block_count(); ++id) all.push_back(id);
+    fetch(all);
+    gathered_ = halo_->rank() == rank;
+  }
+  /// Free the memory of the blocks brought by fetch, gather_to or gather (collective): the
+  /// process keeps the blocks it computes and those their ghost plans read, as after a
+  /// regrid. The partition and the measured block costs stay; no result changes.
+  void release_fetched() {
+    if (!split()) return;
+    reattach_if_moved();
+    const std::vector<double> cost = cost_;
+    const long steps = cost_steps_;
+    keep_held_storage();
+    attach_halo();  // the halo reads the new arrays; the same partition (weights unchanged)
+    cost_ = cost;
+    cost_steps_ = steps;
+    gathered_ = false;
+  }
+  /// The leaves whose extent along `axis` (box coordinates) meets [lo, hi], in tree order.
+  std::vector<index_t> blocks_meeting(int axis, double lo, double hi) const {
+    require(axis >= 0 && axis < 3 && lo <= hi, "fluid::block_solver::blocks_meeting: bad axis or interval");
+    std::vector<index_t> out;
+    for (index_t id = 0; id < block_count(); ++id) {
+      const auto& g = blocks_[std::size_t(id)].grid;
+      if (g.face(axis, 0) <= hi && g.face(axis, n_) >= lo) out.push_back(id);
+    }
+    return out;
+  }
+  /// The listed leaves and every leaf across one of their faces (of any level; periodic
+  /// axes wrap), in tree order without repeats: what a cell's face neighbours can be.
+  std::vector<index_t> with_face_neighbours(const std::vector<index_t>& ids) const {
+    std::vector<char> mark(blocks_.size(), 0);
+    auto under = [&](auto&& self, const blocks::location& q) -> void {
+      const blocks::cover c = tree_.find(q);
+      if (c.kind == blocks::cover::leaf) mark[std::size_t(c.id)] = 1;
+      else if (c.kind == blocks::cover::finer)
+        for (int ch = 0; ch < 8; ++ch) self(self, q.child(ch));
+    };
+    for (index_t id : ids) {
+      mark[std::size_t(id)] = 1;
+      const blocks::location q = blocks_[std::size_t(id)].where;
+      for (int d = 0; d < 3; ++d)
+        for (int side : {-1, 1}) {
+          blocks::location n = q;
+          n.l[std::size_t(d)] += side;
+          under(under, n);
+        }
+    }
+    std::vector<index_t> out;
+    for (index_t id = 0; id < block_count(); ++id)
+      if (mark[std::size_t(id)]) out.push_back(id);
+    return out;
   }
   /// What a halo reads and writes: the tree, plans, corrections, storage and block costs.
   blocks::mesh_view mesh_view() {
@@ -654,7 +773,8 @@ class block_solver {
   /// own (e.g. a wall distance) from computed_blocks() before the next step. It moves no
   /// whole state: each process builds the new blocks it will compute (the halo's forecast
   /// of the new partition) from the old blocks it fetches (fetch_sources); the other blocks
-  /// hold a gas at rest until gather().
+  /// hold zeros (and take no memory, paged storage) until the halo or gather() brings their
+  /// cells.
   template <class Target>
   bool regrid(Target&& target, int max_level) {
     require(max_level >= 0 && max_level <= blocks::tree::max_depth,
@@ -763,22 +883,12 @@ class block_solver {
     const index_t per_block = (n_ + 2 * ng) * (n_ + 2 * ng) * (n_ + 2 * ng);
     stride_ = index_t(simd::padded(std::size_t(per_block))) + index_t(simd::width);
     const index_t total = stride_ * index_t(nleaf);
-    U_ = std::make_unique<cons_storage>(total, 0.0);
-    U0_ = std::make_unique<cons_storage>(total, 0.0);
-    // Cells that no exchange, boundary or transfer writes (corner ghosts, the outer edge
-    // ghosts) hold a gas at rest (ρ = 1, p = (γ − 1)·1): the primitives and the viscous pass
-    // compute on every cell of a block, and only finite values there are harmless.
-    for (auto* u : {U_.get(), U0_.get()}) {
-      std::fill_n(u->template get<field::rho>(), total, 1.0);
-      std::fill_n(u->template get<field::E>(), total, 1.0);
-    }
-    dU_ = std::make_unique<cons_storage>(total, 0.0);
-    W_ = std::make_unique<prim_storage>(total, 1.0);
+    U_ = std::make_unique<cons_storage>(total);
+    U0_ = std::make_unique<cons_storage>(total);
+    dU_ = std::make_unique<cons_storage>(total);
+    W_ = std::make_unique<prim_storage>(total);
     S_.reset();
-    if constexpr (has_eddy_viscosity) {
-      T_ = std::make_unique<turbulence_storage>(total, 0.0);
-      if constexpr (needs_wall_distance) std::fill_n(T_->template get<field::wall_distance>(), total, 1e30);
-    }
+    if constexpr (has_eddy_viscosity) T_ = std::make_unique<turbulence_storage>(total);
     for (std::size_t id = 0; id < nleaf; ++id) {
       block& b = blocks_[id];
       b.where = tree_.leaf(index_t(id));
@@ -814,6 +924,68 @@ class block_solver {
     for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
     attach_halo();
+    for_computed([&](index_t id) { initialize_block_storage(id); });
+  }
+
+  /// Storage for the blocks this process holds only: the mesh-wide arrays made anew, with
+  /// the cells of the blocks it computes and of those their ghost plans read copied over;
+  /// the other blocks become zero and cost no memory (paged storage). After a new split,
+  /// whose state was replicated on every process.
+  void keep_held_storage() {
+    std::vector<char> held(blocks_.size(), 0);
+    for (index_t id : computed_) {
+      held[std::size_t(id)] = 1;
+      blocks::plan_reads(plan_[std::size_t(id)], n_,
+                         [&](const blocks::cell_ref& c) { held[std::size_t(c.block)] = 1; });
+    }
+    // The state (and sources, eddy viscosity) of every held block; the stage copy, rates and
+    // primitives only of the computed ones (no other block's are read).
+    auto keep = [&](auto& array, const std::vector<char>& which) {
+      using storage = typename std::remove_reference_t<decltype(array)>::element_type;
+      if (!array) return;
+      auto fresh = std::make_unique<storage>(array->size());
+      for (std::size_t id = 0; id < which.size(); ++id) {
+        if (!which[id]) continue;
+        const index_t off = stride_ * index_t(id);
+        for (std::size_t f = 0; f < storage::field_count; ++f)
+          std::copy_n(array->data(f) + off, stride_, fresh->data(f) + off);
+      }
+      array = std::move(fresh);
+    };
+    keep(U_, held);
+    keep(U0_, computes_);
+    keep(dU_, computes_);
+    keep(W_, computes_);
+    keep(S_, held);
+    if constexpr (has_eddy_viscosity) keep(T_, held);
+    for (std::size_t id = 0; id < blocks_.size(); ++id) {
+      block& b = blocks_[id];
+      const index_t off = stride_ * index_t(id);
+      b.U = {U_.get(), off};
+      b.U0 = {U0_.get(), off};
+      b.dU = {dU_.get(), off};
+      b.W = {W_.get(), off};
+      if (S_) b.sources = {S_.get(), off};
+      if constexpr (has_eddy_viscosity) b.T = {T_.get(), off};
+      U_all_[id] = detail::conserved_ptrs(b.U);
+    }
+  }
+
+  /// The arrays of a block this process computes, before anything else writes them: cells
+  /// that no exchange, boundary or transfer writes (corner ghosts, the outer edge ghosts)
+  /// hold a gas at rest (ρ = 1, p = (γ − 1)·1), since the primitives and the viscous pass
+  /// compute on every cell of a block and only finite values there are harmless; the wall
+  /// distance is far (1e30). The blocks of other processes stay zero (and cost no memory)
+  /// except the cells the halo brings (interior cells that ghost plans read).
+  void initialize_block_storage(index_t id) {
+    const index_t off = stride_ * id, end = off + stride_;
+    for (auto* u : {U_.get(), U0_.get()}) {
+      std::fill(u->template get<field::rho>() + off, u->template get<field::rho>() + end, 1.0);
+      std::fill(u->template get<field::E>() + off, u->template get<field::E>() + end, 1.0);
+    }
+    for (std::size_t f = 0; f < prim_storage::field_count; ++f) std::fill(W_->data(f) + off, W_->data(f) + end, 1.0);
+    if constexpr (needs_wall_distance)
+      std::fill(T_->template get<field::wall_distance>() + off, T_->template get<field::wall_distance>() + end, 1e30);
   }
 
   /// The blocks this process computes, from the halo (all without one), listed by what they
@@ -856,7 +1028,7 @@ class block_solver {
   }
 
   void allocate_sources() {
-    S_ = std::make_unique<source_storage>(stride_ * block_count(), 0.0);
+    S_ = std::make_unique<source_storage>(stride_ * block_count());
     for (std::size_t id = 0; id < blocks_.size(); ++id) blocks_[id].sources = {S_.get(), stride_ * index_t(id)};
   }
 
@@ -1658,6 +1830,8 @@ class block_solver {
     std::vector<index_t> wanted;
     for (index_t id = 0; id < block_count(); ++id)
       if (want[std::size_t(id)]) wanted.push_back(id);
+    for (index_t id : wanted)
+      if (!computes_[std::size_t(id)]) initialize_block_storage(id);  // its ghosts; the fetch brings its cells
     halo_->fetch_blocks(wanted);
     const auto geo = detail::geometry(pose_);
     for_ids(fill, [&](index_t id) { fill_block_ghosts(id, t_, geo); });

@@ -55,6 +55,7 @@
 /// during a write leaves the previous checkpoint intact.
 #pragma once
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -87,6 +88,14 @@ inline constexpr std::string_view checkpoint_magic = "PARAFSI-CHECKPOINT\n";
 inline constexpr std::uint32_t checkpoint_version = 2;
 
 namespace ckpt {
+
+/// A structure-of-arrays container (soa, paged_soa): fields by tag, a length.
+template <class S>
+concept soa_like = requires(const S& s) {
+  S::field_count;
+  { s.size() } -> std::convertible_to<index_t>;
+  { s.data(std::size_t(0)) } -> std::convertible_to<const double*>;
+};
 
 /// Allocated length of a soa field of n entries (soa::resize: padded + one pack).
 inline std::size_t soa_length(index_t n) { return simd::padded(std::size_t(n)) + simd::width; }
@@ -225,8 +234,9 @@ class output_archive {
     count(n);
     raw(p, n * sizeof(double));
   }
-  template <class... Tags>
-  void fields(std::string_view group, const soa<Tags...>& s) {
+  template <template <class...> class Soa, class... Tags>
+  requires ckpt::soa_like<Soa<Tags...>>
+  void fields(std::string_view group, const Soa<Tags...>& s) {
     const std::size_t L = ckpt::soa_length(s.size());
     (array(std::string(group) + "." + Tags::name, s.template get<Tags>(), L), ...);
   }
@@ -329,8 +339,9 @@ class input_archive {
     take(p, n * sizeof(double));
     finite(name, p, n);
   }
-  template <class... Tags>
-  void fields(std::string_view group, soa<Tags...>& s) {
+  template <template <class...> class Soa, class... Tags>
+  requires ckpt::soa_like<Soa<Tags...>>
+  void fields(std::string_view group, Soa<Tags...>& s) {
     const std::size_t L = ckpt::soa_length(s.size());
     (array(std::string(group) + "." + Tags::name, s.template get<Tags>(), L), ...);
   }

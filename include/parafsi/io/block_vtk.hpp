@@ -31,7 +31,8 @@
 /// are the whole mesh's, value for value). Piece 0 also writes `<stem>.pvtu`, a
 /// PUnstructuredGrid naming the arrays and the pieces (paths relative to the index), which
 /// ParaView opens as one data set (and which a .pvd can list). Every process must hold the
-/// current state of the blocks its piece and their face neighbours (block_solver::gather()).
+/// current state of the blocks its piece and their face neighbours: block_solver::fetch(
+/// s.with_face_neighbours(piece's blocks)) brings just those (or gather() every block).
 ///
 /// Vorticity: the box-frame velocity û = Rᵀu of a leaf cell and of its six face
 /// neighbours (the leaf cells holding the points ξ_c ± h_d e_d, of any level) gives the

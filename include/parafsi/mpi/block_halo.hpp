@@ -32,8 +32,9 @@
 /// their owners only the old blocks those are built from (fetch_blocks: an all-to-all of
 /// the block lists, then one message per peer each way).
 ///
-/// Not yet: storage for owned blocks and their neighbours only (every process holds every
-/// block's arrays).
+/// Memory: the solver's mesh-wide arrays are paged storage (core/soa.hpp), so a process is
+/// backed only for the blocks it computes and those their ghost plans read (the halo writes
+/// their interior cells); gather_state() brings every block to every process (output).
 ///
 /// References: Message Passing Interface Forum (2021) MPI: A Message-Passing Interface
 ///   Standard, version 4.0 (non-blocking point-to-point, MPI_Allgatherv);

@@ -577,6 +577,9 @@ class drop_run {
     require(!previous.rows.empty() && previous.rows.back().t <= s_.time() + 1e-12, "parachute_drop: checkpoint '",
             c_.restart, "' holds ", previous.rows.size(), " history rows, the last not at or before its time ",
             s_.time(), " s");
+    // Every process read the whole mesh; each keeps what it computes and its ghosts read.
+    if constexpr (block_mesh)
+      if (distributed()) s_.fluid().release_fetched();
     if (!c_.quiet)
       std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows carried)\n",
                    c_.restart.c_str(), s_.time(), previous.rows.size());
@@ -628,12 +631,22 @@ class drop_run {
   }
 
   /// VTK files and the checkpoint when their instants are reached (on every process: a
-  /// distributed mesh is gathered first; process 0 writes, but for the fluid's VTK pieces,
-  /// one per process).
+  /// distributed mesh brings each process the blocks it writes, collectively; process 0
+  /// writes, but for the fluid's VTK pieces, one per process).
   void write_outputs() {
     const bool vtk = !c_.out.empty() && c_.vtk_every > 0 && s_.time() >= next_vtk_ - 1e-9 * c_.history_every;
     const bool ckpt = !c_.out.empty() && c_.checkpoint_every > 0 && s_.time() >= next_ckpt_ - 1e-9 * c_.history_every;
-    if (vtk || ckpt) gather_fluid();
+    if constexpr (block_mesh)
+      if (distributed()) {
+        auto& f = s_.fluid();
+        if (vtk) {  // a piece's blocks and their face neighbours (the vorticity's)
+          const auto r = io::piece_blocks(f.block_count(), c_.halo->rank(), c_.halo->size());
+          std::vector<index_t> piece;
+          for (index_t id = r.first; id < r.last; ++id) piece.push_back(id);
+          f.fetch(f.with_face_neighbours(piece));
+        }
+        if (ckpt) f.gather_to(0);  // the whole mesh on the process writing the file
+      }
     if (vtk) {
       char nm[64];
       std::snprintf(nm, sizeof nm, "%09.5f", s_.time());
@@ -666,19 +679,26 @@ class drop_run {
       if (files_) io::save_checkpoint(c_.out + "/checkpoint.ckpt", signature_, s_, io::drop_history_record{*history_});
       next_ckpt_ += c_.checkpoint_every;
     }
+    if constexpr (block_mesh)
+      if (distributed() && (vtk || ckpt)) s_.fluid().release_fetched();
   }
 
   void write_slice(double t_label) {
-    gather_fluid();
-    if (!files_) return;
-    io::write_drop_slice(out(), t_label, s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
-                         structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
+    if constexpr (block_mesh)
+      if (distributed()) {  // the blocks the mid-plane ξ_y ≈ 0 cuts, to the writing process
+        auto& f = s_.fluid();
+        const double h = f.layout().cell_width(1, f.tree().finest_level());
+        f.fetch(files_ ? f.blocks_meeting(1, -h, h) : std::vector<index_t>{});
+      }
+    if (files_)
+      io::write_drop_slice(out(), t_label, s_.fluid(), s_.structure().node_set(), su_.scene.canopy_nodes,
+                           structure::payload(s_.structure()).body().mass_centre_velocity(), p_offset_);
+    if constexpr (block_mesh)
+      if (distributed()) s_.fluid().release_fetched();
   }
 
-  /// A distributed block mesh's cells to every process (collective; nothing otherwise).
-  void gather_fluid() {
-    if constexpr (block_mesh) s_.fluid().gather();
-  }
+  /// Whether the block mesh is split over several processes.
+  bool distributed() const { return c_.halo && c_.halo->size() > 1; }
 
   /// Block mesh: refine to the canopy's current place (drop_block_target) and, with
   /// --refine-vorticity X, where the wake turns the velocity by more than X times the

@@ -136,7 +136,7 @@ class block_solver {
     slice<prim_storage> W;
     slice<source_storage> sources;                   ///< per-cell sources (after enable_sources)
     slice<turbulence_storage> T;                     ///< eddy viscosity (and wall distance), if a closure
-    simd::aligned_vector<double> faces;              ///< face register: [axis][side][component][n²]
+    double* faces = nullptr;  ///< face register [axis][side][component][n²], in the mesh-wide paged array
     std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
     std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
     std::vector<char> bad_rows;
@@ -566,7 +566,7 @@ class block_solver {
     m.U = &U_all_;
     m.registers.resize(blocks_.size());
     m.weight = weights_or_uniform(weight_, blocks_.size());
-    for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces.data();
+    for (std::size_t id = 0; id < blocks_.size(); ++id) m.registers[id] = blocks_[id].faces;
     if constexpr (has_eddy_viscosity) {
       m.mu_t.resize(blocks_.size());
       for (std::size_t id = 0; id < blocks_.size(); ++id) m.mu_t[id] = blocks_[id].T.template get<field::mu_t>();
@@ -913,11 +913,11 @@ class block_solver {
       b.dU = {dU_.get(), off};
       b.W = {W_.get(), off};
       if constexpr (has_eddy_viscosity) b.T = {T_.get(), off};
-      b.faces.assign(std::size_t(3 * 2 * 5 * n2), 0.0);
       b.bad_rows.assign(std::size_t(n2), 0);
       setup_sponge(b);
     }
     if (sources_on_) allocate_sources();
+    allocate_registers();
     plan_ = blocks::build_plan(tree_, n_, /*edges=*/is_viscous);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
     U_all_.resize(nleaf);
@@ -952,6 +952,7 @@ class block_solver {
       }
       array = std::move(fresh);
     };
+    allocate_registers();  // the halo reads them anew (attach_halo after this)
     keep(U_, held);
     keep(U0_, computes_);
     keep(dU_, computes_);
@@ -1032,9 +1033,18 @@ class block_solver {
     for (std::size_t id = 0; id < blocks_.size(); ++id) blocks_[id].sources = {S_.get(), stride_ * index_t(id)};
   }
 
+  /// The blocks' face registers, one paged array (zero, backed where written: the blocks a
+  /// process sweeps and the finer blocks whose entries its corrections receive). They hold
+  /// one stage's fluxes, written before they are read, so a new array needs no copy.
+  void allocate_registers() {
+    const std::size_t size = std::size_t(blocks::register_size(n_));
+    registers_ = zeroed_array(size * blocks_.size());
+    for (std::size_t id = 0; id < blocks_.size(); ++id) blocks_[id].faces = registers_.data() + id * size;
+  }
+
   detail::face_register register_of(block& b, int axis) noexcept {
     const std::size_t n2 = std::size_t(n_ * n_);
-    double* base = b.faces.data() + std::size_t(axis) * 10 * n2;
+    double* base = b.faces + std::size_t(axis) * 10 * n2;
     detail::face_register r;
     for (std::size_t f = 0; f < 5; ++f) {
       r.lo[f] = base + f * n2;
@@ -2013,6 +2023,7 @@ class block_solver {
   index_t n_ = 0;
   std::vector<block> blocks_;
   index_t stride_ = 0;  ///< cells per block in the mesh-wide arrays
+  zeroed_array registers_;  ///< every block's face register (allocate_registers)
   std::unique_ptr<cons_storage> U_, U0_, dU_;
   std::unique_ptr<prim_storage> W_;
   std::unique_ptr<source_storage> S_;                     ///< null until enable_sources

@@ -36,6 +36,30 @@ TEST_CASE("soa: named fields, 64-byte alignment, padded tails") {
   CHECK(s.span<a_tag>().size() == 13);
 }
 
+TEST_CASE("paged_soa: zero when made, 64-byte aligned, the padded length of soa, moves keep the data") {
+  // Large enough that the C library maps fresh pages (the lazily backed case) and small.
+  for (index_t n : {index_t(13), index_t(3'000'000)}) {
+    paged_soa<a_tag, b_tag> s(n);
+    CHECK(s.size() == n);
+    for (std::size_t f = 0; f < 2; ++f) CHECK(reinterpret_cast<std::uintptr_t>(s.data(f)) % 64 == 0);
+    const std::size_t len = simd::padded(std::size_t(n)) + simd::width;  // as soa allocates
+    double sum = 0.0;
+    for (std::size_t i = 0; i < len; ++i) sum += std::fabs(s.get<a_tag>()[i]) + std::fabs(s.get<b_tag>()[i]);
+    CHECK(sum == 0.0);
+    s.get<b_tag>()[len - 1] = 4.0;
+    s.get<a_tag>()[n / 2] = -1.5;
+    const double* before = s.data(1);
+    paged_soa<a_tag, b_tag> t(std::move(s));
+    CHECK(t.data(1) == before);
+    CHECK(t.get<b_tag>()[len - 1] == 4.0);
+    CHECK(t.get<a_tag>()[n / 2] == -1.5);
+    paged_soa<a_tag, b_tag> u;
+    u = std::move(t);
+    CHECK(u.get<a_tag>()[n / 2] == -1.5);
+    CHECK(u.size() == n);
+  }
+}
+
 TEST_CASE("for_each_pack covers [begin, end) once: packs, then the scalar tail") {
   for (index_t n : {0, 1, 7, 8, 9, 31, 64, 65}) {
     std::vector<int> hits(std::size_t(n) + 3, 0);

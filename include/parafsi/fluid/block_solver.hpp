@@ -134,9 +134,9 @@ class block_solver {
     rectilinear_grid grid;
     slice<cons_storage> U, U0, dU;
     slice<prim_storage> W;
-    slice<source_storage> sources;                   ///< per-cell sources (after enable_sources)
-    slice<turbulence_storage> T;                     ///< eddy viscosity (and wall distance), if a closure
-    double* faces = nullptr;  ///< face register [axis][side][component][n²], in the mesh-wide paged array
+    slice<source_storage> sources;  ///< per-cell sources (after enable_sources)
+    slice<turbulence_storage> T;    ///< eddy viscosity (and wall distance), if a closure
+    double* faces = nullptr;        ///< face register [axis][side][component][n²], in the mesh-wide paged array
     std::optional<soa<field::sponge_sigma>> sponge;  ///< sponge rate where the layer reaches
     std::array<bool, 6> boundary{};                  ///< faces on the box boundary filled by a condition
     std::vector<char> bad_rows;
@@ -417,7 +417,8 @@ class block_solver {
     attach_halo();
     if (halo_ && halo_->size() > 1) {
       keep_held_storage();
-      attach_halo();  // the halo reads the new arrays
+      attach_halo();      // the halo reads the new arrays
+      gathered_ = false;  // the others' blocks are no longer held here
     }
   }
   const blocks::halo* halo() const noexcept { return halo_.get(); }
@@ -484,19 +485,21 @@ class block_solver {
   void fetch(const std::vector<index_t>& ids) {
     if (!split()) return;
     reattach_if_moved();
+    const bool valid = std::all_of(ids.begin(), ids.end(), [&](index_t id) { return id >= 0 && id < block_count(); });
+    agree(valid, "fluid::block_solver::fetch: a listed block is not a leaf of the mesh");  // every process stops
     std::vector<index_t> wanted;
-    for (index_t id : ids) {
-      require(id >= 0 && id < block_count(), "fluid::block_solver::fetch: no block ", id);
+    for (index_t id : ids)
       if (!computes_[std::size_t(id)]) wanted.push_back(id);
-    }
     std::sort(wanted.begin(), wanted.end());
     wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+    for (index_t id : wanted) initialize_block_state(id);  // its ghosts at rest, its wall distance far
     halo_->fetch_blocks(wanted);
     gathered_ = false;
   }
   /// Every block's interior cells to process `rank` only (collective): before that process
   /// writes a checkpoint (the whole mesh on it, the others unchanged).
   void gather_to(int rank) {
+    require(!halo_ || (rank >= 0 && rank < halo_->size()), "fluid::block_solver::gather_to: no process ", rank);
     if (!split()) {
       gathered_ = true;  // one process holds every block
       return;
@@ -542,6 +545,7 @@ class block_solver {
         for (int ch = 0; ch < 8; ++ch) self(self, q.child(ch));
     };
     for (index_t id : ids) {
+      require(id >= 0 && id < block_count(), "fluid::block_solver::with_face_neighbours: no block ", id);
       mark[std::size_t(id)] = 1;
       const blocks::location q = blocks_[std::size_t(id)].where;
       for (int d = 0; d < 3; ++d)
@@ -664,8 +668,11 @@ class block_solver {
   static void serialize(Archive& ar, Self& self) {
     if constexpr (!Archive::loading)
       require(!self.halo_ || self.gathered_,
-              "fluid::block_solver: a distributed mesh is written after gather() (every process), from one process");
+              "fluid::block_solver: a distributed mesh is written after gather_to(this process) or gather(), from "
+              "one process");
     ar.check("type", self.name(), "the solver type");
+    ar.check("state_layout", std::string("interior cells, blocks in tree order"),
+             "the layout of the stored state (an earlier version stored whole blocks with their ghosts)");
     ar.check("ghosts", std::int64_t(ng), "the number of ghost layers");
     for (int d = 0; d < 3; ++d) {
       const std::string a = std::to_string(d);
@@ -707,9 +714,37 @@ class block_solver {
       self.weight_.clear();  // a new mesh: uniform weights until costs are measured
       self.build();
     }
-    ar.fields("conserved", *self.U_);
+    // The conserved state of the interior cells only (the ghosts are filled again before
+    // they are read: a stage fills them first, and so does a regrid's prolongation).
+    self.interior_fields(ar, "conserved", *self.U_);
     if (sources) ar.fields("sources", *self.S_);
     if constexpr (has_eddy_viscosity) ar.fields("turbulence", *self.T_);
+  }
+
+  /// Every field of `st` as one array of the blocks' interior cells (block by block in tree
+  /// order, i fastest): written from, or read into, the mesh-wide arrays.
+  template <class Archive, class... Tags>
+  void interior_fields(Archive& ar, const std::string& group, paged_soa<Tags...>& st) const {
+    const blocks::block_index at{n_};
+    const std::size_t n3 = std::size_t(n_ * n_ * n_), nb = blocks_.size();
+    std::vector<double> buf(n3 * nb);
+    auto one = [&](const char* name, double* a) {
+      auto each = [&](auto&& f) {
+        for (std::size_t id = 0; id < nb; ++id)
+          for (index_t k = 0, o = 0; k < n_; ++k)
+            for (index_t j = 0; j < n_; ++j)
+              for (index_t i = 0; i < n_; ++i, ++o)
+                f(buf[id * n3 + std::size_t(o)], a[std::size_t(stride_) * id + std::size_t(at(i, j, k))]);
+      };
+      if constexpr (Archive::loading) {
+        ar.array(group + "." + name, buf.data(), buf.size());
+        each([](double& v, double& cell) { cell = v; });
+      } else {
+        each([](double& v, double& cell) { v = cell; });
+        ar.array(group + "." + name, std::as_const(buf).data(), buf.size());
+      }
+    };
+    (one(Tags::name, st.template get<Tags>()), ...);
   }
 
   /// Per leaf (tree order), max over its cells of |ω| h: the vorticity magnitude (central
@@ -938,8 +973,10 @@ class block_solver {
       blocks::plan_reads(plan_[std::size_t(id)], n_,
                          [&](const blocks::cell_ref& c) { held[std::size_t(c.block)] = 1; });
     }
-    // The state (and sources, eddy viscosity) of every held block; the stage copy, rates and
-    // primitives only of the computed ones (no other block's are read).
+    // The state and eddy viscosity (and wall distance) of every held block; the stage copy,
+    // rates and primitives only of the computed ones (no other block's are read). The
+    // sources stay as they are: a caller writes them on every process (set_halo), and
+    // nothing moves them between processes.
     auto keep = [&](auto& array, const std::vector<char>& which) {
       using storage = typename std::remove_reference_t<decltype(array)>::element_type;
       if (!array) return;
@@ -957,7 +994,6 @@ class block_solver {
     keep(U0_, computes_);
     keep(dU_, computes_);
     keep(W_, computes_);
-    keep(S_, held);
     if constexpr (has_eddy_viscosity) keep(T_, held);
     for (std::size_t id = 0; id < blocks_.size(); ++id) {
       block& b = blocks_[id];
@@ -979,14 +1015,23 @@ class block_solver {
   /// distance is far (1e30). The blocks of other processes stay zero (and cost no memory)
   /// except the cells the halo brings (interior cells that ghost plans read).
   void initialize_block_storage(index_t id) {
+    initialize_block_state(id);
     const index_t off = stride_ * id, end = off + stride_;
-    for (auto* u : {U_.get(), U0_.get()}) {
-      std::fill(u->template get<field::rho>() + off, u->template get<field::rho>() + end, 1.0);
-      std::fill(u->template get<field::E>() + off, u->template get<field::E>() + end, 1.0);
-    }
+    at_rest(*U0_, off, end);
     for (std::size_t f = 0; f < prim_storage::field_count; ++f) std::fill(W_->data(f) + off, W_->data(f) + end, 1.0);
+  }
+  /// A block brought from another process (fetch, regrid, rebalance): its state a gas at
+  /// rest and its wall distance far (1e30), before its cells arrive.
+  void initialize_block_state(index_t id) {
+    const index_t off = stride_ * id, end = off + stride_;
+    at_rest(*U_, off, end);
     if constexpr (needs_wall_distance)
       std::fill(T_->template get<field::wall_distance>() + off, T_->template get<field::wall_distance>() + end, 1e30);
+  }
+  static void at_rest(cons_storage& u, index_t off, index_t end) {
+    for (std::size_t f = 0; f < cons_storage::field_count; ++f) std::fill(u.data(f) + off, u.data(f) + end, 0.0);
+    std::fill(u.template get<field::rho>() + off, u.template get<field::rho>() + end, 1.0);
+    std::fill(u.template get<field::E>() + off, u.template get<field::E>() + end, 1.0);
   }
 
   /// The blocks this process computes, from the halo (all without one), listed by what they
@@ -1841,7 +1886,7 @@ class block_solver {
     for (index_t id = 0; id < block_count(); ++id)
       if (want[std::size_t(id)]) wanted.push_back(id);
     for (index_t id : wanted)
-      if (!computes_[std::size_t(id)]) initialize_block_storage(id);  // its ghosts; the fetch brings its cells
+      if (!computes_[std::size_t(id)]) initialize_block_state(id);  // its ghosts; the fetch brings its cells
     halo_->fetch_blocks(wanted);
     const auto geo = detail::geometry(pose_);
     for_ids(fill, [&](index_t id) { fill_block_ghosts(id, t_, geo); });
@@ -2022,7 +2067,7 @@ class block_solver {
   long steps_ = 0;
   index_t n_ = 0;
   std::vector<block> blocks_;
-  index_t stride_ = 0;  ///< cells per block in the mesh-wide arrays
+  index_t stride_ = 0;      ///< cells per block in the mesh-wide arrays
   zeroed_array registers_;  ///< every block's face register (allocate_registers)
   std::unique_ptr<cons_storage> U_, U0_, dU_;
   std::unique_ptr<prim_storage> W_;

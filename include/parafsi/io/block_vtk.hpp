@@ -130,16 +130,26 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
   const index_t n = s.block_cells(), nb = s.block_count();
   r = detail::whole(r, nb);
   const Eigen::Matrix3d R = s.pose().R;
-  std::vector<Eigen::Vector3d> ub(std::size_t(s.cell_count()));
-  for (index_t id = 0; id < nb; ++id) {
-    const auto& b = s.block_at(id);
-    for (index_t k = 0; k < n; ++k)
-      for (index_t j = 0; j < n; ++j)
-        for (index_t i = 0; i < n; ++i) {
-          const auto w = detail::block_cell_prim(b, b.grid.index(i, j, k), s.gas());
-          ub[detail::leaf_cell(id, n, i, j, k)] = R.transpose() * Eigen::Vector3d(w.u.x, w.u.y, w.u.z);
-        }
-  }
+  // The box-frame velocity of the blocks the range reads (its own and their face
+  // neighbours), each block's once, when first needed: memory for those blocks only (a
+  // process writing its piece holds only them, block_solver::fetch).
+  const std::size_t n3 = std::size_t(n * n * n);
+  std::vector<index_t> slot(std::size_t(nb), -1);
+  std::vector<Eigen::Vector3d> ubs;
+  auto ub_of = [&](index_t id, std::size_t local) -> const Eigen::Vector3d& {
+    if (slot[std::size_t(id)] < 0) {
+      slot[std::size_t(id)] = index_t(ubs.size() / n3);
+      const auto& b = s.block_at(id);
+      for (index_t k = 0; k < n; ++k)
+        for (index_t j = 0; j < n; ++j)
+          for (index_t i = 0; i < n; ++i) {
+            const auto w = detail::block_cell_prim(b, b.grid.index(i, j, k), s.gas());
+            ubs.push_back(R.transpose() * Eigen::Vector3d(w.u.x, w.u.y, w.u.z));
+          }
+    }
+    return ubs[std::size_t(slot[std::size_t(id)]) * n3 + local];
+  };
+  auto local_of = [&](index_t i, index_t j, index_t k) { return std::size_t(i + n * (j + n * k)); };
   const std::size_t skip = 3 * detail::leaf_cell(r.first, n, 0, 0, 0);
   std::vector<double> out(3 * detail::leaf_cell(r.last, n, 0, 0, 0) - skip);
   for (index_t id = r.first; id < r.last; ++id) {
@@ -157,10 +167,11 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
               index_t q[3] = {i, j, k};
               q[d] += sgn;
               Eigen::Vector3d xn;
+              index_t other_block = id;
               std::size_t other;
               if (q[d] >= 0 && q[d] < n) {  // inside the block
                 xn = {g.centre(0, q[0]), g.centre(1, q[1]), g.centre(2, q[2])};
-                other = detail::leaf_cell(id, n, q[0], q[1], q[2]);
+                other = local_of(q[0], q[1], q[2]);
               } else {
                 Eigen::Vector3d p = xc;
                 p[d] += sgn * g.width(d, ijk[d]);
@@ -169,9 +180,11 @@ std::vector<double> vorticity(const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& 
                 const auto& gn = s.block_at(nid).grid;
                 const auto a = gn.ijk(nc);
                 xn = {gn.centre(0, a[0]), gn.centre(1, a[1]), gn.centre(2, a[2])};
-                other = detail::leaf_cell(nid, n, a[0], a[1], a[2]);
+                other_block = nid;
+                other = local_of(a[0], a[1], a[2]);
               }
-              const Eigen::Vector3d dx = xn - xc, du = ub[other] - ub[self];
+              const Eigen::Vector3d u_other = ub_of(other_block, other);
+              const Eigen::Vector3d dx = xn - xc, du = u_other - ub_of(id, local_of(i, j, k));
               M += dx * dx.transpose();
               B += du * dx.transpose();
             }

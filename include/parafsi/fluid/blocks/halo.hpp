@@ -2,9 +2,9 @@
 /// What a block mesh split over several processes needs, without naming how the data
 /// travel (the MPI implementation is mpi/block_halo.hpp, behind its own target).
 ///
-/// Every process keeps the whole tree, its exchange plans and flux corrections, and storage
-/// for every block (the mesh's metadata is small; the storage is replicated for now, see
-/// docs/guide_mpi.md), but computes only the blocks it owns: a contiguous range of the
+/// Every process keeps the whole tree, its exchange plans and flux corrections, and the
+/// mesh-wide arrays in paged storage, backed only for the blocks it holds (its own and those
+/// its ghost plans read; docs/guide_mpi.md, Memory), and computes only the blocks it owns: a contiguous range of the
 /// leaves' Morton order, cut by cost (`partition`, with the blocks' measured seconds per
 /// step as weights: fluid::block_solver::rebalance), and the blocks every process computes
 /// (optionally, e.g. for coupling::penalty: the finest level, where a coupling reads and

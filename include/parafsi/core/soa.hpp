@@ -149,24 +149,18 @@ class paged_soa {
   std::array<zeroed_array, sizeof...(Tags)> data_{};
 };
 
-template <class L>
-struct soa_of;
-template <class... Tags>
-struct soa_of<meta::list<Tags...>> {
-  using type = soa<Tags...>;
+/// C<Tags...> for the tags of a type list (C: soa or paged_soa).
+template <template <class...> class C, class L>
+struct with_fields;
+template <template <class...> class C, class... Tags>
+struct with_fields<C, meta::list<Tags...>> {
+  using type = C<Tags...>;
 };
 /// soa container holding exactly the fields of a type list.
 template <class L>
-using soa_of_t = typename soa_of<L>::type;
-
-template <class L>
-struct paged_soa_of;
-template <class... Tags>
-struct paged_soa_of<meta::list<Tags...>> {
-  using type = paged_soa<Tags...>;
-};
+using soa_of_t = typename with_fields<soa, L>::type;
 /// paged_soa container holding exactly the fields of a type list.
 template <class L>
-using paged_soa_of_t = typename paged_soa_of<L>::type;
+using paged_soa_of_t = typename with_fields<paged_soa, L>::type;
 
 }  // namespace parafsi

@@ -415,7 +415,7 @@ class block_solver {
     weight_.clear();   // a new split: uniform until costs are measured
     gathered_ = true;  // the caller's promise: every process holds the same state
     attach_halo();
-    if (halo_ && halo_->size() > 1) {
+    if (split()) {
       keep_held_storage();
       attach_halo();      // the halo reads the new arrays
       gathered_ = false;  // the others' blocks are no longer held here
@@ -456,7 +456,7 @@ class block_solver {
   /// changes process is fetched from its old owner (halo::fetch_blocks; no whole-state
   /// gather); the results do not change by a bit, only who computes what.
   void rebalance() {
-    if (!halo_ || halo_->size() == 1) return;
+    if (!split()) return;
     reattach_if_moved();
     std::vector<double> w = measured_weights(tree_, tree_);
     // The blocks this process takes over come from their present owners.
@@ -474,7 +474,7 @@ class block_solver {
   /// when not distributed).
   void gather() {
     reattach_if_moved();
-    if (halo_ && halo_->size() > 1) halo_->gather_state();
+    if (split()) halo_->gather_state();
     gathered_ = true;
   }
   /// The listed blocks' interior cells (and eddy viscosity, with a closure) from the
@@ -843,12 +843,12 @@ class block_solver {
     if (next.leaves() == tree_.leaves()) {
       // The first partition weighed every block 1; once costs are measured, cut by them
       // (once: later partitions come with the regrids that change the mesh, or rebalance()).
-      if (halo_ && halo_->size() > 1 && weight_.empty() && cost_steps_ > 0) rebalance();
+      if (split() && weight_.empty() && cost_steps_ > 0) rebalance();
       return false;
     }
     // Split over processes, each process builds only the new blocks it will compute, from
     // the old blocks it fetches (fetch_sources); otherwise every block from every block.
-    const bool split = halo_ && halo_->size() > 1;
+    const bool split = this->split();
     reattach_if_moved();
     std::vector<double> next_weight = halo_ ? measured_weights(tree_, next) : std::vector<double>{};
     if (split) fetch_sources(next, next_weight);
@@ -942,21 +942,14 @@ class block_solver {
         b.boundary[std::size_t(2 * d + 1)] = !tree_.periodic(d) && b.where.l[du] + 1 == tree_.extent(d, b.where.level);
       }
       b.grid = rectilinear_grid(std::move(ax[0]), std::move(ax[1]), std::move(ax[2]));
-      const index_t off = stride_ * index_t(id);
-      b.U = {U_.get(), off};
-      b.U0 = {U0_.get(), off};
-      b.dU = {dU_.get(), off};
-      b.W = {W_.get(), off};
-      if constexpr (has_eddy_viscosity) b.T = {T_.get(), off};
       b.bad_rows.assign(std::size_t(n2), 0);
       setup_sponge(b);
     }
     if (sources_on_) allocate_sources();
     allocate_registers();
+    attach_slices();
     plan_ = blocks::build_plan(tree_, n_, /*edges=*/is_viscous);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
-    U_all_.resize(nleaf);
-    for (std::size_t id = 0; id < nleaf; ++id) U_all_[id] = detail::conserved_ptrs(blocks_[id].U);
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
     attach_halo();
     for_computed([&](index_t id) { initialize_block_storage(id); });
@@ -995,6 +988,13 @@ class block_solver {
     keep(dU_, computes_);
     keep(W_, computes_);
     if constexpr (has_eddy_viscosity) keep(T_, held);
+    attach_slices();
+  }
+
+  /// Every block's slices of the mesh-wide arrays (block id at id · stride()), and the
+  /// state pointers the exchange plans use.
+  void attach_slices() {
+    U_all_.resize(blocks_.size());
     for (std::size_t id = 0; id < blocks_.size(); ++id) {
       block& b = blocks_[id];
       const index_t off = stride_ * index_t(id);
@@ -1017,21 +1017,20 @@ class block_solver {
   void initialize_block_storage(index_t id) {
     initialize_block_state(id);
     const index_t off = stride_ * id, end = off + stride_;
-    at_rest(*U0_, off, end);
+    std::fill(U0_->template get<field::rho>() + off, U0_->template get<field::rho>() + end, 1.0);
+    std::fill(U0_->template get<field::E>() + off, U0_->template get<field::E>() + end, 1.0);
     for (std::size_t f = 0; f < prim_storage::field_count; ++f) std::fill(W_->data(f) + off, W_->data(f) + end, 1.0);
   }
   /// A block brought from another process (fetch, regrid, rebalance): its state a gas at
   /// rest and its wall distance far (1e30), before its cells arrive.
   void initialize_block_state(index_t id) {
     const index_t off = stride_ * id, end = off + stride_;
-    at_rest(*U_, off, end);
-    if constexpr (needs_wall_distance)
-      std::fill(T_->template get<field::wall_distance>() + off, T_->template get<field::wall_distance>() + end, 1e30);
-  }
-  static void at_rest(cons_storage& u, index_t off, index_t end) {
+    auto& u = *U_;  // a block held before may carry momentum: all five fields
     for (std::size_t f = 0; f < cons_storage::field_count; ++f) std::fill(u.data(f) + off, u.data(f) + end, 0.0);
     std::fill(u.template get<field::rho>() + off, u.template get<field::rho>() + end, 1.0);
     std::fill(u.template get<field::E>() + off, u.template get<field::E>() + end, 1.0);
+    if constexpr (needs_wall_distance)
+      std::fill(T_->template get<field::wall_distance>() + off, T_->template get<field::wall_distance>() + end, 1e30);
   }
 
   /// The blocks this process computes, from the halo (all without one), listed by what they

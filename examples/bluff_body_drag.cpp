@@ -42,6 +42,19 @@
 // `shedding_periods=` the periods of that frequency the second half holds; `strouhal=none`
 // when the probe's amplitude is below 0.01 U (a steady wake) or the record holds fewer than
 // three periods (a drift, not a measurement).
+//
+// Mesh: `--mesh tensor` (default) is the stretched rectilinear grid above. `--mesh blocks`
+// puts the same box on the block-structured mesh (fluid/block_solver.hpp; blocks of
+// --block-size³ cells): the finest level, cells of D/N, on every block that meets the core
+// [−0.5D, core-length] × [−core-width, core-width]², each coarser level a ring at least one
+// block thick (the 2:1 balance), the root blocks at most half the box's narrowest side. The
+// root grid has block faces on x = −0.5D and on the axis, so the finest cells lie where the
+// tensor grid's core cells do; the box is grown to whole root blocks (upstream from
+// −0.5D, laterally about the axis) and the sponge is the whole number of root cells closest
+// to 1.2 D (the tensor grid's 4 outer cells span 0.95-1.34 D across the stream). The mesh is
+// built once, before the first step (the body is fixed), so the cells are where the wake
+// needs them at a fraction of the tensor grid's count at 24–32 cells per diameter
+// (coupling.md §8.1).
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
@@ -56,10 +69,40 @@
 namespace pf = parafsi;
 namespace st = pf::structure;
 
+namespace {
+
+/// The block mesh's layout (see the file comment): blocks of n³ cells, the finest cell h
+/// on level L, L the largest that leaves at least two root blocks (n 2^L h) across the
+/// box's narrowest side; root faces on x = −0.5 D and on the axis, the box grown to whole
+/// root blocks: upstream to at least −2.5 D, downstream to `length` D, laterally to
+/// ±`width` D. Returns the layout and L.
+std::pair<pf::fluid::block_layout, int> core_blocks(double D, double h, int n, double length, double width) {
+  const double narrow = std::min(2.0 * width * D, (2.5 + length) * D);
+  const int L = std::max(0, int(std::floor(std::log2(narrow / (2.0 * n * h) + 1e-9))));
+  if (L > pf::fluid::blocks::tree::max_depth)
+    throw std::invalid_argument("bluff_body_drag: " + std::to_string(L) + " levels are too many (fewer --cells)");
+  const double root = double(n) * h * std::ldexp(1.0, L);
+  const auto whole = [&](double span) { return pf::index_t(std::ceil(span / root - 1e-9)); };
+  pf::fluid::block_layout lay;
+  lay.block_cells = n;
+  const pf::index_t up = whole(2.0 * D), down = whole((length + 0.5) * D), side = whole(width * D);
+  lay.lo = {-0.5 * D - double(up) * root, -double(side) * root, -double(side) * root};
+  lay.hi = {-0.5 * D + double(down) * root, double(side) * root, double(side) * root};
+  lay.root_blocks = {up + down, 2 * side, 2 * side};
+  for (pf::index_t nb : lay.root_blocks)
+    if (nb > pf::fluid::blocks::tree::max_root)
+      throw std::invalid_argument("bluff_body_drag: " + std::to_string(nb) +
+                                  " root blocks on an axis, more than the tree holds (a smaller box)");
+  return {lay, L};
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Drag of a fixed disk or hemispherical cup in a uniform stream (penalty or embedded coupling)"};
   examples::common_options co;
-  std::string shape = "disk", coupling = "embedded", out, fabric = "none", closure = "none";
+  std::string shape = "disk", coupling = "embedded", out, fabric = "none", closure = "none", mesh = "tensor";
+  int block_size = 8;
   double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0, kick = 0.0;
   // The grid, in diameters: uniform cells of D/N in [-0.5, core_length] x [-core_width, core_width]^2,
   // stretched out to [-2.5, domain_length] x [-domain_width, domain_width]^2.
@@ -117,6 +160,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--stretch", stretch, "growth of the cells outside the core, per cell")
       ->check(CLI::Range(1.0, 1.5))
+      ->capture_default_str();
+  app.add_option("--mesh", mesh,
+                 "fluid mesh: tensor (the stretched rectilinear grid) or blocks (the block-structured mesh, the "
+                 "finest level on the core)")
+      ->check(CLI::IsMember({"tensor", "blocks"}))
+      ->capture_default_str();
+  app.add_option("--block-size", block_size, "cells per block edge (--mesh blocks)")
+      ->check(CLI::IsMember({4, 8, 16, 32}))
       ->capture_default_str();
   app.add_option("--pfac", pfac, "penalty factor PFAC (penalty coupling)")
       ->check(CLI::Range(1e-4, 1e3))
@@ -178,33 +229,55 @@ int main(int argc, char** argv) {
     const double mu = Re > 0 ? rho * U * D / Re : (closure != "none" ? 1.79e-5 : 0.0);
     if (!co.quiet)
       std::fprintf(stderr,
-                   "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, grid %lld x %lld x %lld = %lld "
-                   "cells (core to %g D behind, +-%g D; box to %g D, +-%g D, blockage %.2g %%), %zu triangles, "
+                   "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, %s grid %lld x %lld x %lld = "
+                   "%lld cells (core to %g D behind, +-%g D; box to %g D, +-%g D, blockage %.2g %%), %zu triangles, "
                    "t_end = %g s (%g D/U), %s\n",
-                   shape.c_str(), coupling.c_str(), D, U, cells, (long long)grid.n(0), (long long)grid.n(1),
-                   (long long)grid.n(2), (long long)grid.interior_cells(), core_length, core_width, domain_length,
-                   domain_width, 100.0 * std::numbers::pi / 16.0 / (domain_width * domain_width), dm.triangles.size(),
-                   t_end, t_end * U / D,
+                   shape.c_str(), coupling.c_str(), D, U, cells,
+                   mesh == "tensor" ? "mesh: tensor" : "(the tensor mesh's)", (long long)grid.n(0),
+                   (long long)grid.n(1), (long long)grid.n(2), (long long)grid.interior_cells(), core_length,
+                   core_width, domain_length, domain_width,
+                   100.0 * std::numbers::pi / 16.0 / (domain_width * domain_width), dm.triangles.size(), t_end,
+                   t_end * U / D,
                    mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str() : "inviscid");
 
     // Wake probe: the cell holding (2D, 0, 0).
+    const Eigen::Vector3d probe_point(2 * D, 0.0, 0.0);
     std::array<pf::index_t, 3> probe{};
     for (int d = 0; d < 3; ++d) {
       const auto& f = grid.axis_of(d).faces;
-      probe[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), d == 0 ? 2 * D : 0.0) - f.begin()) - 1;
+      probe[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), probe_point[d]) - f.begin()) - 1;
     }
-    if (probe[0] >= grid.n(0) - bc.layer.cells)
+    if (mesh == "tensor" && probe[0] >= grid.n(0) - bc.layer.cells)
       throw std::invalid_argument("bluff_body_drag: the wake probe at 2 D lies in the far-field sponge (the last " +
                                   std::to_string(bc.layer.cells) + " cells); lengthen the box (--domain-length)");
     auto run_with = [&](auto fl) -> int {
+      using Fluid = decltype(fl);
+      constexpr bool blocks = requires { fl.tree(); };
       fl.fill_uniform({rho, {U, kick * U, 0}, p0});
-      if constexpr (decltype(fl)::needs_wall_distance) {
+      if constexpr (blocks) {
+        const auto [b, c] = fl.locate(probe_point);
+        if (b < 0 || fl.sponge_rate(b, c) > 0.0)
+          throw std::invalid_argument("bluff_body_drag: the wake probe at 2 D lies in the far-field sponge (the last " +
+                                      std::to_string(bc.layer.cells) +
+                                      " root cells); lengthen the box (--domain-length)");
+        if (parafsi::parallel::max_threads() > 1) fl.set_threading(true);
+      }
+      if constexpr (Fluid::needs_wall_distance) {
         std::vector<Eigen::Vector3d> pts(std::size_t(as.node_set().size()));
         for (pf::index_t i = 0; i < as.node_set().size(); ++i) pts[std::size_t(i)] = as.node_set().position(i);
         const auto& ml = fl.turbulence();
-        pf::fluid::distance_to_points(fl.grid(), pts, ml.c_l * ml.ref_length / ml.kappa,
-                                      std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())),
-                                      true);
+        if constexpr (blocks) {
+          for (pf::index_t id = 0; id < fl.block_count(); ++id) {
+            const auto& g = fl.block_at(id).grid;
+            pf::fluid::distance_to_points(g, pts,
+                                          ml.wall_reach(std::cbrt(g.width(0, 0) * g.width(1, 0) * g.width(2, 0))),
+                                          std::span<double>(fl.wall_distance(id), std::size_t(g.total_cells())), true);
+          }
+        } else {
+          pf::fluid::distance_to_points(fl.grid(), pts, ml.wall_reach(std::numeric_limits<double>::infinity()),
+                                        std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())),
+                                        true);
+        }
       }
       auto run = [&](auto cpl) -> int {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};
@@ -224,7 +297,9 @@ int main(int argc, char** argv) {
           const Eigen::Vector3d c = s.coupling().diagnostics().impulse_structure / dt / qA;
           const double cd = c.x();
           if (!c.allFinite()) throw pf::numerical_failure("bluff_body_drag: the body force is not finite", 0, s.time());
-          const auto wp = s.fluid().primitive(probe[0], probe[1], probe[2]);
+          pf::fluid::prim<double> wp;
+          if constexpr (blocks) wp = s.fluid().sample(probe_point);
+          else wp = s.fluid().primitive(probe[0], probe[1], probe[2]);
           csv.row({s.time(), cd, c.y(), c.z(), wp.u.y / U, wp.u.z / U});
           if (s.time() > t_avg) {
             ts.push_back(s.time());
@@ -276,23 +351,47 @@ int main(int argc, char** argv) {
       }
       return with(pf::porosity::impermeable{});
     };
+    // The fluid on the chosen mesh with the given policies (flux and reconstruction first).
+    auto with_fluid = [&](auto... policies) -> int {
+      if (mesh == "tensor") return run_with(pf::fluid::solver{grid, bc, policies...});
+      const auto [lay, levels] = core_blocks(D, h, block_size, domain_length, domain_width);
+      // The block mesh's sponge is counted in root cells (a width that varies with N and the
+      // block size): as many as make it closest to 1.2 D (the tensor grid's 4 outer cells: 0.95-1.34 D).
+      auto bcb = bc;
+      bcb.layer.cells = std::max(1, int(std::lround(1.2 * D / lay.cell_width(0, 0))));
+      pf::fluid::block_solver fl{pf::fluid::blocks::tree(lay.root_blocks), lay, bcb, policies...};
+      fl.regrid(pf::fluid::blocks::in_box{lay,
+                                          {-0.5 * D, -core_width * D, -core_width * D},
+                                          {core_length * D, core_width * D, core_width * D},
+                                          levels},
+                levels);
+      if (!co.quiet) {
+        std::vector<long> per(std::size_t(levels + 1), 0);
+        for (const auto& q : fl.tree().leaves()) ++per[std::size_t(q.level)];
+        std::string counts;
+        for (int l = 0; l <= levels; ++l) counts += (l ? " / " : "") + std::to_string(per[std::size_t(l)]);
+        std::fprintf(stderr,
+                     "bluff_body_drag: block mesh, box [%g, %g] x [%g, %g]^2 m, %lld blocks of %d^3 (levels 0-%d: "
+                     "%s), %lld cells, sponge %d root cells (%.3g D)\n",
+                     lay.lo[0], lay.hi[0], lay.lo[1], lay.hi[1], (long long)fl.block_count(), block_size, levels,
+                     counts.c_str(), (long long)fl.cell_count(), bcb.layer.cells,
+                     bcb.layer.cells * lay.cell_width(0, 0) / D);
+      }
+      return run_with(std::move(fl));
+    };
     using muscl = pf::recon::muscl<pf::limiter::van_leer>;
     if (closure == "mixing_length") {
       pf::turbulence::prandtl_mixing_length ml;
       ml.ref_length = D;
       ml.mu_cap = 1000.0 * mu;
-      return run_with(
-          pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::prandtl_mixing_length, pf::viscosity::constant>{
-              grid, bc, ml, pf::viscosity::constant{mu, 0.72}});
+      return with_fluid(pf::flux::hllc_lm{}, muscl{}, ml, pf::viscosity::constant{mu, 0.72});
     }
     if (closure == "smagorinsky") {
       pf::turbulence::smagorinsky sm;
       sm.mu_cap = 1000.0 * mu;
-      return run_with(pf::fluid::solver<pf::flux::hllc_lm, muscl, pf::turbulence::smagorinsky, pf::viscosity::constant>{
-          grid, bc, sm, pf::viscosity::constant{mu, 0.72}});
+      return with_fluid(pf::flux::hllc_lm{}, muscl{}, sm, pf::viscosity::constant{mu, 0.72});
     }
-    if (mu > 0)
-      return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, muscl{}, pf::viscosity::constant{mu, 0.72}});
-    return run_with(pf::fluid::solver{grid, bc, pf::flux::hllc_lm{}, muscl{}});
+    if (mu > 0) return with_fluid(pf::flux::hllc_lm{}, muscl{}, pf::viscosity::constant{mu, 0.72});
+    return with_fluid(pf::flux::hllc_lm{}, muscl{});
   });
 }

@@ -112,6 +112,13 @@ if(TARGET bluff_body_drag)
   parafsi_coupling_example(example_coupling_bluff_disk_box bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ " --shape disk --cells 4 --time 0.002 --core-length 3 --core-width 1 --domain-length 8
     --domain-width 3 --stretch 1.2 --quiet)
+  # The block mesh (the finest level on the core, 2:1 rings outside), with a closure's wall distance on blocks.
+  parafsi_coupling_example(example_coupling_bluff_disk_blocks bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
+    "drag_coefficient=[0-9.e+-]+ " --shape disk --mesh blocks --cells 8 --time 0.0005 --quiet)
+  parafsi_coupling_example(example_coupling_bluff_cup_blocks_mixing_length bluff_body_drag
+    "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
+    "drag_coefficient=[0-9.e+-]+ .* closure=mixing_length" --shape cup --mesh blocks --block-size 4 --cells 8 --time 0.0005
+    --closure mixing_length --quiet)
   parafsi_coupling_example_fails(example_coupling_bluff_probe_in_sponge bluff_body_drag --domain-length 2.5
     --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_sliver_cell bluff_body_drag --core-width 2.49

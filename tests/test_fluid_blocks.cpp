@@ -531,6 +531,40 @@ TEST_CASE("refinement near a structure: every structure point and its buffer lie
   CHECK_THROWS_WITH_AS(fb::near_points(lay, pts, -1.0, 3), doctest::Contains("buffer"), invalid_input);
 }
 
+TEST_CASE("box criterion: the finest level covers the box, whole parents wide, and a shared face is outside") {
+  // Root blocks of 1 m in [0, 4]^3, refined to level 2 (blocks of 0.25 m) on the open box
+  // (0.5, 1.3) x (1, 2) x (1, 2). Leaves come from splits, so the finest region is the
+  // level-1 blocks (0.5 m) the box meets: x in [0.5, 1.5] (1.3 lies in the second), y and
+  // z in [1, 2] (the faces at 1 and 2 are shared, not entered): 2 x 2 x 2 level-1 blocks,
+  // 64 leaves of level 2. The same box shifted by 1e-3 m in y enters the block below 1.
+  fluid::block_layout lay{{0, 0, 0}, {4, 4, 4}, {4, 4, 4}, 4};
+  auto finest = [&](std::array<double, 3> lo, std::array<double, 3> hi, fb::block_box& span) {
+    fb::tree t({4, 4, 4});
+    t.refine_where(2, [&](const fb::location& q) { return fb::in_box{lay, lo, hi, 2}(q) > q.level; });
+    int n = 0;
+    span = {{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+    for (const auto& q : t.leaves())
+      if (q.level == 2) {
+        ++n;
+        const fb::block_box b = fb::box_of(lay, q);
+        for (std::size_t d = 0; d < 3; ++d) {
+          span.lo[d] = std::min(span.lo[d], b.lo[d]);
+          span.hi[d] = std::max(span.hi[d], b.hi[d]);
+        }
+      }
+    return n;
+  };
+  fb::block_box span;
+  CHECK(finest({0.5, 1.0, 1.0}, {1.3, 2.0, 2.0}, span) == 64);
+  for (std::size_t d = 0; d < 3; ++d) {
+    CHECK(span.lo[d] == doctest::Approx(d == 0 ? 0.5 : 1.0));
+    CHECK(span.hi[d] == doctest::Approx(d == 0 ? 1.5 : 2.0));
+  }
+  CHECK(finest({0.5, 1.0 - 1e-3, 1.0}, {1.3, 2.0, 2.0}, span) == 96);
+  CHECK(span.lo[1] == doctest::Approx(0.5));
+  CHECK(fb::in_box{lay, {0.5, 1.0, 1.0}, {1.3, 2.0, 2.0}, 2}({0, {3, 3, 3}}) == 0);
+}
+
 TEST_CASE("graded refinement criterion: the binned, bounding-box-pruned query equals testing every point") {
   // Points on a tilted ring and a line (a skirt and a riser) in a 5 x 5 x 7 m box of
   // 2 x 2 x 3 root blocks; every location of levels 0-4 asked, against the brute force:

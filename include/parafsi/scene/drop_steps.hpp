@@ -96,12 +96,7 @@ fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f
 /// its finest cells), 0 elsewhere; the 2:1 balance grades the rest.
 template <class Layout>
 auto drop_column_target(const Layout& lay, const model::drop_box& b, int level) {
-  return [lay, lo = b.fine_lo, hi = b.fine_hi, level](const fluid::blocks::location& q) {
-    const fluid::blocks::block_box bb = fluid::blocks::box_of(lay, q);
-    for (std::size_t d = 0; d < 3; ++d)
-      if (bb.hi[d] <= lo[d] || bb.lo[d] >= hi[d]) return 0;
-    return level;
-  };
+  return fluid::blocks::in_box{lay, b.fine_lo, b.fine_hi, level};
 }
 
 /// Place the box `b` of fluid `f` at the payload of `a`: R = the box axes, X = the payload

@@ -24,6 +24,11 @@
 ///     wants one level finer (up to max_level), one below `coarsen_below` one level coarser,
 ///     else its level; a regrid thus moves a level at a time and the gap between the two
 ///     thresholds keeps a refined block from coarsening at once (|ω| h halves when h does).
+///   in_box{layout, lo, hi, level}: `level` on every block whose box overlaps the open box
+///     (lo, hi) (box coordinates), 0 elsewhere; the 2:1 balance grades the rest. A fixed
+///     region held fine: a bluff body's core and near wake, the tensor box's refined column.
+///     Leaves come from splitting, so the fine region is the union of whole blocks of the
+///     level above that meet the box (up to one such block wider than (lo, hi) on a side).
 ///   max_of{a, b}: the finer of two criteria's targets.
 #pragma once
 #include <algorithm>
@@ -158,6 +163,26 @@ class near_points {
   std::unordered_map<std::uint64_t, bin> bins_;
   block_box all_{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
 };
+
+/// `level` on the blocks that overlap the open box (lo, hi), 0 elsewhere (see the file comment).
+template <class Layout>
+struct in_box {
+  Layout lay;
+  std::array<double, 3> lo, hi;
+  int level;
+
+  int operator()(const location& q) const {
+    const block_box b = box_of(lay, q);
+    // A block that only touches the box (a shared face, to round-off) is outside it.
+    for (std::size_t d = 0; d < 3; ++d) {
+      const double tol = 1e-12 * (std::fabs(lo[d]) + std::fabs(hi[d]) + (hi[d] - lo[d]));
+      if (b.hi[d] <= lo[d] + tol || b.lo[d] >= hi[d] - tol) return 0;
+    }
+    return level;
+  }
+};
+template <class Layout>
+in_box(Layout, std::array<double, 3>, std::array<double, 3>, int) -> in_box<Layout>;
 
 /// A flow criterion from one value per leaf of the current tree (see the file comment).
 class leaf_indicator {

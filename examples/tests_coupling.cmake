@@ -119,6 +119,13 @@ if(TARGET bluff_body_drag)
     "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ .* closure=mixing_length" --shape cup --mesh blocks --block-size 4 --cells 8 --time 0.0005
     --closure mixing_length --quiet)
+  # The scheme's dissipation: HLLC without the low-Mach fix and the minmod limiter (inviscid only).
+  parafsi_coupling_example(example_coupling_bluff_disk_hllc_minmod bluff_body_drag
+    "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w" "drag_coefficient=[0-9.e+-]+ .* flux=hllc limiter=minmod"
+    --shape disk --cells 4 --time 0.002 --flux hllc --limiter minmod --quiet)
+  parafsi_example_refuses(example_coupling_bluff_minmod_viscous bluff_body_drag ""
+    "--flux and --limiter other than hllc_lm and van_leer need inviscid air" --limiter minmod --closure smagorinsky
+    --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_probe_in_sponge bluff_body_drag --domain-length 2.5
     --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_sliver_cell bluff_body_drag --core-width 2.49

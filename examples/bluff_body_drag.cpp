@@ -31,6 +31,14 @@
 // the cloth. Then `through_fraction=` is also printed: the mean through-velocity over the
 // body (the coupling's through-flow / its area) over U, averaged like the drag.
 //
+// The embedded coupling blocks whole grid faces: a face is a wall when the segment between
+// its two cell centres crosses the body, so the body's frontal area is the count of
+// stream-normal blocked faces times h², a staircase whose area differs from πR² by a
+// few per cent, with the sign set by how the rim falls on the grid (+13 % at 6 cells per
+// diameter, +3.5 % at 8 and 16, −1 % at 12 and 24). The program prints
+// `blocked_area_ratio=` (that area over πR²) and `drag_coefficient_on_blocked_area=` (the
+// drag over ½ρU² times that area: the coefficient of the body the air sees).
+//
 // Wake: `--closure mixing_length|smagorinsky` adds that eddy viscosity to the air's
 // (μ = 1.79e-5 Pa s unless --reynolds sets it; mixing length l_m = min(κ d_w, 0.07 D, Δ),
 // d_w from the body's nodes; Smagorinsky C_s = 0.1; μ_t ≤ 1000 μ, as the drop scene).
@@ -297,7 +305,7 @@ int main(int argc, char** argv) {
         examples::csv_writer csv(out, "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w");
         std::vector<double> ts, pv, pw;  // the second half, for the probe's spectrum
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
-        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0;
+        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0, blocked_area = 0;
         examples::step_guard guard("bluff_body_drag", t_end);
         while (s.time() < t_end * (1.0 - 1e-12)) {
           double dt = guard(s.stable_dt(co.cfl), s.time());
@@ -307,6 +315,12 @@ int main(int argc, char** argv) {
           const double t0 = s.time();
           s.step(dt);
           max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
+          // The embedded body blocks whole faces (those whose cell-centre segment it
+          // crosses): its frontal area is the stream-normal faces' count times h² (the
+          // body lies in cells of h), not πR². Fixed body: the same faces every step.
+          if constexpr (requires { s.coupling().patch_faces(); })
+            if (blocked_area == 0.0)
+              for (const auto& f : s.coupling().patch_faces()) blocked_area += f.axis == 0 ? h * h : 0.0;
           const Eigen::Vector3d c = s.coupling().diagnostics().impulse_structure / dt / qA;
           const double cd = c.x();
           if (!c.allFinite()) throw pf::numerical_failure("bluff_body_drag: the body force is not finite", 0, s.time());
@@ -338,6 +352,9 @@ int main(int argc, char** argv) {
             cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
         if constexpr (decltype(cpl)::porosity_type::permeable)
           std::printf(" through_fraction=%.6g", sum_t > 0 ? sum_q / sum_t : 0.0);
+        if (blocked_area > 0)
+          std::printf(" blocked_area_ratio=%.6g drag_coefficient_on_blocked_area=%.6g", blocked_area / area,
+                      cd * area / blocked_area);
         // The wake probe: its dominant frequency in St ∈ [0.02, 2] over the second half.
         if (ts.size() >= 8 && (ts.back() - ts.front()) * U / D > 1.0) {
           const auto pk = pf::io::dominant_frequency(ts, {pv, pw}, 0.02 * U / D, 2.0 * U / D);

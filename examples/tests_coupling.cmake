@@ -114,7 +114,12 @@ if(TARGET bluff_body_drag)
     --domain-width 3 --stretch 1.2 --quiet)
   # The block mesh (the finest level on the core, 2:1 rings outside), with a closure's wall distance on blocks.
   parafsi_coupling_example(example_coupling_bluff_disk_blocks bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
-    "drag_coefficient=[0-9.e+-]+ " --shape disk --mesh blocks --cells 8 --time 0.0005 --quiet)
+    "drag_coefficient=[0-9.e+-]+ .* blocked_area_ratio=1.03451 " --shape disk --mesh blocks --cells 8 --time 0.0005 --quiet)
+  # The staircase disk at 8 cells per diameter on the tensor grid (a face line on the axis): 52 face
+  # centres (i + 1/2, j + 1/2) h inside radius 4 h, 52 / 16π = 1.03451 of the disk's area.
+  parafsi_coupling_example(example_coupling_bluff_disk_blocked_area bluff_body_drag
+    "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w" "blocked_area_ratio=1.03451 "
+    --shape disk --cells 8 --time 0.0002 --quiet)
   parafsi_coupling_example(example_coupling_bluff_cup_blocks_mixing_length bluff_body_drag
     "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ .* closure=mixing_length" --shape cup --mesh blocks --block-size 4 --cells 8 --time 0.0005

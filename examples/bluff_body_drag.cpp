@@ -19,7 +19,7 @@
 // growth) change it (coupling.md §8.1); characteristic far field on all six faces with a 4-cell sponge towards
 // the free stream; impulsive start from the uniform stream. HLLC-LM flux, MUSCL van
 // Leer, SSP-RK2 (for inviscid air `--flux hllc` drops the low-Mach fix and `--limiter
-// minmod` takes the more diffusive limiter: the scheme's dissipation in the wake, §8.1).
+// minmod` takes the more diffusive limiter: the scheme's dissipation in the wake, §8.2).
 // Inviscid by default (separation fixed by the sharp edge); --reynolds RE
 // switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer
 // on the body is not resolved by either coupling).
@@ -34,8 +34,8 @@
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of
 // stream-normal blocked faces times h², a staircase whose area differs from πR² by a
-// few per cent, with the sign set by how the rim falls on the grid (+13 % at 6 cells per
-// diameter, +3.5 % at 8 and 16, −1 % at 12 and 24). The program prints
+// few per cent, with the sign set by how the rim falls on the grid (on the axis of these grids
+// −8 % at 6 cells per diameter, +3.5 % at 8 and 16, −1 % at 12 and 24). The program prints
 // `blocked_area_ratio=` (that area over πR²) and `drag_coefficient_on_blocked_area=` (the
 // drag over ½ρU² times that area: the coefficient of the body the air sees).
 //
@@ -64,7 +64,7 @@
 // to 1.2 D (the tensor grid's 4 outer cells span 0.95-1.34 D across the stream). The mesh is
 // built once, before the first step (the body is fixed), so the cells are where the wake
 // needs them at a fraction of the tensor grid's count at 24–32 cells per diameter
-// (coupling.md §8.1).
+// (coupling.md §8.2).
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
@@ -278,9 +278,9 @@ int main(int argc, char** argv) {
       if constexpr (blocks) {
         const auto [b, c] = fl.locate(probe_point);
         if (b < 0 || fl.sponge_rate(b, c) > 0.0)
-          throw std::invalid_argument("bluff_body_drag: the wake probe at 2 D lies in the far-field sponge (the last " +
-                                      std::to_string(bc.layer.cells) +
-                                      " root cells); lengthen the box (--domain-length)");
+          throw std::invalid_argument(
+              "bluff_body_drag: the wake probe at 2 D lies in the far-field sponge; lengthen the box "
+              "(--domain-length)");
         if (parafsi::parallel::max_threads() > 1) fl.set_threading(true);
       }
       if constexpr (Fluid::needs_wall_distance) {

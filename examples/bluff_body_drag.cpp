@@ -34,8 +34,9 @@
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of
 // stream-normal blocked faces times h², a staircase whose area differs from πR² by a
-// few per cent, with the sign set by how the rim falls on the grid (on the axis of these grids
-// −8 % at 6 cells per diameter, +3.5 % at 8 and 16, −1 % at 12 and 24). The program prints
+// few per cent, with the sign set by how the rim falls on the grid (on the tensor grid −8 % at
+// 6 cells per diameter, where the axis runs through cell centres, +3.5 % at 8 and 16, −1 % at
+// 12 and 24). The program prints
 // `blocked_area_ratio=` (that area over πR²) and `drag_coefficient_on_blocked_area=` (the
 // drag over ½ρU² times that area: the coefficient of the body the air sees).
 //
@@ -59,12 +60,11 @@
 // [−0.5D, core-length] × [−core-width, core-width]², each coarser level a ring at least one
 // block thick (the 2:1 balance), the root blocks at most half the box's narrowest side. The
 // root grid has block faces on x = −0.5D and on the axis, so the finest cells lie where the
-// tensor grid's core cells do; the box is grown to whole root blocks (upstream from
-// −0.5D, laterally about the axis) and the sponge is the whole number of root cells closest
-// to 1.2 D (the tensor grid's 4 outer cells span 0.95-1.34 D across the stream). The mesh is
-// built once, before the first step (the body is fixed), so the cells are where the wake
-// needs them at a fraction of the tensor grid's count at 24–32 cells per diameter
-// (coupling.md §8.2).
+// tensor grid's core cells do when the axis is a face line there (even N); the box is grown to whole root blocks
+// (upstream from −0.5D, laterally about the axis) and the sponge is the whole number of root cells closest to 1.2 D
+// (the tensor grid's 4 outer cells span 0.95-1.34 D across the stream in the default box). The mesh is built once,
+// before the first step (the body is fixed), so the cells are where the wake needs them at a fraction of the tensor
+// grid's count (0.65 at 16 cells per diameter, 0.43 at 24) (coupling.md §8.2).
 #include "example_common.hpp"
 
 #include <parafsi/coupling/coupling.hpp>
@@ -316,11 +316,20 @@ int main(int argc, char** argv) {
           s.step(dt);
           max_pen = std::max(max_pen, s.coupling().diagnostics().max_penetration_over_h);
           // The embedded body blocks whole faces (those whose cell-centre segment it
-          // crosses): its frontal area is the stream-normal faces' count times h² (the
-          // body lies in cells of h), not πR². Fixed body: the same faces every step.
+          // crosses): its frontal area is the stream-normal blocked faces' area, not πR².
+          // Fixed body: the same faces every step.
           if constexpr (requires { s.coupling().patch_faces(); })
             if (blocked_area == 0.0)
-              for (const auto& f : s.coupling().patch_faces()) blocked_area += f.axis == 0 ? h * h : 0.0;
+              for (const auto& f : s.coupling().patch_faces())
+                if (f.axis == 0) {  // the face's area: its high cell's widths across the stream
+                  const auto& fl = s.fluid();
+                  auto add = [&](const pf::fluid::rectilinear_grid& g, pf::index_t cell) {
+                    const auto ijk = g.ijk(cell);
+                    blocked_area += g.width(1, ijk[1]) * g.width(2, ijk[2]);
+                  };
+                  if constexpr (blocks) add(fl.block_at(f.high / fl.stride()).grid, f.high % fl.stride());
+                  else add(fl.grid(), f.high);
+                }
           const Eigen::Vector3d c = s.coupling().diagnostics().impulse_structure / dt / qA;
           const double cd = c.x();
           if (!c.allFinite()) throw pf::numerical_failure("bluff_body_drag: the body force is not finite", 0, s.time());
@@ -387,7 +396,7 @@ int main(int argc, char** argv) {
       if (mesh == "tensor") return run_with(pf::fluid::solver{grid, bc, policies...});
       const auto [lay, levels] = core_blocks(D, h, block_size, domain_length, domain_width);
       // The block mesh's sponge is counted in root cells (a width that varies with N and the
-      // block size): as many as make it closest to 1.2 D (the tensor grid's 4 outer cells: 0.95-1.34 D).
+      // block size): as many as make it closest to 1.2 D (the tensor grid's 4 outer cells, default box: 0.95-1.34 D).
       auto bcb = bc;
       bcb.layer.cells = std::max(1, int(std::lround(1.2 * D / lay.cell_width(0, 0))));
       pf::fluid::block_solver fl{pf::fluid::blocks::tree(lay.root_blocks), lay, bcb, policies...};
@@ -403,10 +412,11 @@ int main(int argc, char** argv) {
         for (int l = 0; l <= levels; ++l) counts += (l ? " / " : "") + std::to_string(per[std::size_t(l)]);
         std::fprintf(stderr,
                      "bluff_body_drag: block mesh, box [%g, %g] x [%g, %g]^2 m, %lld blocks of %d^3 (levels 0-%d: "
-                     "%s), %lld cells, sponge %d root cells (%.3g D)\n",
+                     "%s), %lld cells, sponge %d root cells (%.3g D), blockage %.2g %%\n",
                      lay.lo[0], lay.hi[0], lay.lo[1], lay.hi[1], (long long)fl.block_count(), block_size, levels,
                      counts.c_str(), (long long)fl.cell_count(), bcb.layer.cells,
-                     bcb.layer.cells * lay.cell_width(0, 0) / D);
+                     bcb.layer.cells * lay.cell_width(0, 0) / D,
+                     100.0 * area / ((lay.hi[1] - lay.lo[1]) * (lay.hi[2] - lay.lo[2])));
       }
       return run_with(std::move(fl));
     };

@@ -120,6 +120,11 @@ if(TARGET bluff_body_drag)
   parafsi_coupling_example(example_coupling_bluff_disk_blocked_area bluff_body_drag
     "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w" "blocked_area_ratio=1.03451 "
     --shape disk --cells 8 --time 0.0002 --quiet)
+  # At 5 cells per diameter the core (±0.75 D) holds 8 cells of 0.0375 m, not D/5: 24 faces of
+  # that width, 24 · 0.0375² / (π 0.1²) = 1.0743 (the area of the faces, not a count times h²).
+  parafsi_coupling_example(example_coupling_bluff_disk_blocked_area_narrow_cells bluff_body_drag
+    "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w" "blocked_area_ratio=1.0743 "
+    --shape disk --cells 5 --time 0.0002 --quiet)
   parafsi_coupling_example(example_coupling_bluff_cup_blocks_mixing_length bluff_body_drag
     "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ .* closure=mixing_length" --shape cup --mesh blocks --block-size 4 --cells 8 --time 0.0005

@@ -372,7 +372,7 @@ int main(int argc, char** argv) {
           std::printf(" probe_amplitude=%.3g shedding_periods=%.3g", pk.amplitude, pk.periods);
         }
         std::printf(" closure=%s reynolds=%.4g mesh=%s flux=%s limiter=%s\n", closure.c_str(),
-                    mu > 0 ? rho * U * D / mu : 0.0, mesh.c_str(), co.flux.c_str(), co.limiter.c_str());
+                    mu > 0 ? rho * U * D / mu : 0.0, mesh.c_str(), Fluid::flux_type::name(), Fluid::recon_type::name());
         return 0;
       };
       auto with = [&](auto por) -> int {

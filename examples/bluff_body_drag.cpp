@@ -276,6 +276,15 @@ int main(int argc, char** argv) {
       constexpr bool blocks = requires { fl.tree(); };
       fl.fill_uniform({rho, {U, kick * U, 0}, p0});
       if constexpr (blocks) {
+        // The sponge counts root cells, so on a narrow box it can reach the body itself.
+        for (const Eigen::Vector3d& x :
+             {Eigen::Vector3d(0, 0.5 * D, 0), Eigen::Vector3d(0, 0, 0.5 * D), Eigen::Vector3d(-0.5 * D, 0, 0)}) {
+          const auto [bx, cx] = fl.locate(x);
+          if (bx < 0 || fl.sponge_rate(bx, cx) > 0.0)
+            throw std::invalid_argument(
+                "bluff_body_drag: the far-field sponge reaches the body's rim or the air just upstream of it; widen "
+                "the box (--domain-width)");
+        }
         const auto [b, c] = fl.locate(probe_point);
         if (b < 0 || fl.sponge_rate(b, c) > 0.0)
           throw std::invalid_argument(

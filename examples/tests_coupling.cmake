@@ -136,6 +136,8 @@ if(TARGET bluff_body_drag)
   parafsi_example_refuses(example_coupling_bluff_minmod_viscous bluff_body_drag ""
     "--flux and --limiter other than hllc_lm and van_leer need inviscid air" --limiter minmod --closure smagorinsky
     --out ${_cpl_out}/unused.csv)
+  parafsi_example_refuses(example_coupling_bluff_blocks_sponge_on_body bluff_body_drag ""
+    "the far-field sponge reaches the body's rim" --mesh blocks --domain-width 1 --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_probe_in_sponge bluff_body_drag --domain-length 2.5
     --out ${_cpl_out}/unused.csv)
   parafsi_coupling_example_fails(example_coupling_bluff_sliver_cell bluff_body_drag --core-width 2.49

@@ -562,7 +562,13 @@ TEST_CASE("box criterion: the finest level covers the box, whole parents wide, a
   }
   CHECK(finest({0.5, 1.0 - 1e-3, 1.0}, {1.3, 2.0, 2.0}, span) == 96);
   CHECK(span.lo[1] == doctest::Approx(0.5));
-  CHECK(fb::in_box{lay, {0.5, 1.0, 1.0}, {1.3, 2.0, 2.0}, 2}({0, {3, 3, 3}}) == 0);
+  // A box that ends two ulps past a block's low face only touches the block (round-off):
+  // outside; 1e-9 m past it, the box enters the block.
+  const fb::location q{2, {2, 4, 4}};  // [0.5, 0.75] x [1, 1.25]^2
+  const double face = fb::box_of(lay, q).lo[0];
+  const double touch = std::nextafter(std::nextafter(face, 10.0), 10.0);
+  CHECK(fb::in_box{lay, {0.25, 1.0, 1.0}, {touch, 2.0, 2.0}, 2}(q) == 0);
+  CHECK(fb::in_box{lay, {0.25, 1.0, 1.0}, {face + 1e-9, 2.0, 2.0}, 2}(q) == 2);
 }
 
 TEST_CASE("graded refinement criterion: the binned, bounding-box-pruned query equals testing every point") {

@@ -69,7 +69,6 @@
 
 #include <parafsi/coupling/coupling.hpp>
 #include <parafsi/explicit_stepper.hpp>
-#include <parafsi/fluid/wall_distance.hpp>
 #include <parafsi/io/spectrum.hpp>
 #include <parafsi/model/disk_mesh.hpp>
 #include <parafsi/model/fabric_catalogue.hpp>
@@ -295,19 +294,8 @@ int main(int argc, char** argv) {
       if constexpr (Fluid::needs_wall_distance) {
         std::vector<Eigen::Vector3d> pts(std::size_t(as.node_set().size()));
         for (pf::index_t i = 0; i < as.node_set().size(); ++i) pts[std::size_t(i)] = as.node_set().position(i);
-        const auto& ml = fl.turbulence();
-        if constexpr (blocks) {
-          for (pf::index_t id = 0; id < fl.block_count(); ++id) {
-            const auto& g = fl.block_at(id).grid;
-            pf::fluid::distance_to_points(g, pts,
-                                          ml.wall_reach(std::cbrt(g.width(0, 0) * g.width(1, 0) * g.width(2, 0))),
-                                          std::span<double>(fl.wall_distance(id), std::size_t(g.total_cells())), true);
-          }
-        } else {
-          pf::fluid::distance_to_points(fl.grid(), pts, ml.wall_reach(std::numeric_limits<double>::infinity()),
-                                        std::span<double>(fl.wall_distance(), std::size_t(fl.grid().total_cells())),
-                                        true);
-        }
+        // Each block within the closure's reach for its own cells (the same eddy viscosity).
+        fl.wall_distance_from(pts);
       }
       auto run = [&](auto cpl) -> int {
         pf::explicit_stepper s{std::move(fl), std::move(as), std::move(cpl)};

@@ -272,3 +272,54 @@ TEST_CASE("eddy viscosity across levels and regrids: conservation to round-off, 
   CHECK(regrids == 1);
   CHECK(worst < 1e-13);
 }
+
+TEST_CASE("wall_distance_from: each block's reach gives the mixing length of the unbounded search") {
+  // Two levels (cells of 1/16 and 1/32 m) and L_ref = 1 m: the closure's cap C_l L_ref =
+  // 0.07 m exceeds both grid caps C_Δ Δ, so a block searches only min(C_l L_ref, C_Δ Δ)/κ
+  // (0.152 and 0.076 m) of the unbounded C_l L_ref/κ = 0.171 m. Where it stops, κ d_w is
+  // not the smallest length, so l_m = min(κ d_w, C_l L_ref, C_Δ Δ) is the same double.
+  viscosity::constant mu;
+  turbulence::prandtl_mixing_length ml;
+  ml.ref_length = 1.0;
+  fluid::block_layout lay{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, 8};
+  fb::tree t({2, 2, 2}, {false, false, false});
+  t.refine_where(1, [](const fb::location& q) { return q.level == 0 && q.l[0] == 1 && q.l[1] == 0 && q.l[2] == 0; });
+  fluid::block_solver blk{t, lay, boundary::set::all(boundary::outflow{}), mu, ml};
+  std::vector<Eigen::Vector3d> pts;
+  for (int a = 0; a <= 12; ++a) {
+    pts.emplace_back(0.3 + 0.05 * a, 0.2, 0.25);
+    pts.emplace_back(0.5, 0.08 * a, 0.6);
+  }
+  blk.wall_distance_from(pts);
+  const double full = ml.c_l * ml.ref_length / ml.kappa;
+  int cut = 0, near = 0, mismatched = 0;
+  for (index_t id = 0; id < blk.block_count(); ++id) {
+    const auto& g = blk.block_at(id).grid;
+    std::vector<double> d(std::size_t(g.total_cells()));
+    fluid::distance_to_points(g, pts, full, d, true);
+    const double delta = std::cbrt(g.width(0, 0) * g.width(1, 0) * g.width(2, 0));
+    const double* dw = blk.wall_distance(id);
+    auto lm = [&](double dist) {
+      return std::min(std::min(ml.kappa * dist, ml.c_l * ml.ref_length), ml.c_delta * delta);
+    };
+    for (index_t c = 0; c < g.total_cells(); ++c) {
+      const auto ijk = g.ijk(c);
+      if (ijk[0] < -2 || ijk[0] >= 10 || ijk[1] < -2 || ijk[1] >= 10 || ijk[2] < -2 || ijk[2] >= 10) continue;
+      if (dw[c] > 1e29 && d[std::size_t(c)] < 1e29) ++cut;
+      if (d[std::size_t(c)] < 1e29) ++near;
+      if (lm(dw[c]) != lm(d[std::size_t(c)])) ++mismatched;
+    }
+  }
+  MESSAGE(near, " cells within the unbounded reach, ", cut, " of them beyond their block's");
+  CHECK(cut > 0);  // the bounded search did skip cells
+  CHECK(near > cut);
+  CHECK(mismatched == 0);
+
+  // The box solver: one reach for every cell, the unbounded one.
+  fluid::solver box{fluid::rectilinear_grid::uniform({16, 16, 16}, lay.lo, lay.hi),
+                    boundary::set::all(boundary::outflow{}), mu, ml};
+  box.wall_distance_from(pts);
+  std::vector<double> d(std::size_t(box.grid().total_cells()));
+  fluid::distance_to_points(box.grid(), pts, full, d, true);
+  CHECK(std::equal(d.begin(), d.end(), box.wall_distance()));
+}

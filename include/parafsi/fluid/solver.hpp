@@ -34,7 +34,9 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -66,6 +68,7 @@
 #include "turbulence/none.hpp"
 #include "view.hpp"
 #include "viscosity/inviscid.hpp"
+#include "wall_distance.hpp"
 
 namespace parafsi::fluid {
 
@@ -263,6 +266,13 @@ class solver {
   }
   /// Distance to the nearest body per cell (mixing-length closure); +∞ by default.
   double* wall_distance() requires needs_wall_distance { return turb_store_.template get<field::wall_distance>(); }
+  /// The wall distance of every cell (ghosts included) from the structure's `points` (box
+  /// coordinates) within the closure's reach (wall_distance.hpp): on a stretched box one
+  /// reach for every cell, the closure's largest.
+  void wall_distance_from(std::span<const Eigen::Vector3d> points) requires needs_wall_distance {
+    distance_to_points(grid_, points, turb_.wall_reach(std::numeric_limits<double>::infinity()),
+                       std::span<double>(wall_distance(), std::size_t(grid_.total_cells())), true);
+  }
   /// The turbulence closure (its constants).
   const Turbulence& turbulence() const noexcept { return turb_; }
 

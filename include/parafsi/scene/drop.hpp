@@ -745,36 +745,13 @@ class drop_run {
   void update_wall_distance() {
     if constexpr (Fluid::needs_wall_distance) {
       auto& f = s_.fluid();
-      const auto& ml = f.turbulence();
       const auto& nd = s_.structure().node_set();
       const Eigen::Matrix3d Rt = f.pose().R.transpose();
       wall_points_.resize(std::size_t(nd.size()));
       for (index_t i = 0; i < nd.size(); ++i) wall_points_[std::size_t(i)] = Rt * (nd.position(i) - f.pose().X);
-      if constexpr (block_mesh) {
-        // Each computed block's cells and ghosts (a ghost's eddy viscosity is then its
-        // neighbour's); over MPI the blocks this process computes. The reach is the
-        // closure's for the block's Δ = (h_x h_y h_z)^(1/3) (its widths, ghosts included, at
-        // their largest): the same eddy viscosity, at a fraction of the cost on fine blocks.
-        const std::vector<index_t>& ids = f.computed_blocks();
-        // Each block's seconds count in its partition weight (block_solver::rebalance).
-        parallel::for_range(0, index_t(ids.size()), [&](index_t k) {
-          const index_t id = ids[std::size_t(k)];
-          const auto t0 = std::chrono::steady_clock::now();
-          const auto& g = f.block_at(id).grid;
-          double hmax[3];
-          for (int d = 0; d < 3; ++d) {
-            const double* w = g.widths(d);
-            hmax[d] = *std::max_element(w - fluid::rectilinear_grid::ghosts,
-                                        w + g.n(d) + fluid::rectilinear_grid::ghosts);
-          }
-          fluid::distance_to_points(g, wall_points_, ml.wall_reach(std::cbrt(hmax[0] * hmax[1] * hmax[2])),
-                                    std::span<double>(f.wall_distance(id), std::size_t(g.total_cells())), true);
-          f.add_block_cost(id, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        });
-      } else {
-        fluid::distance_to_points(f.grid(), wall_points_, ml.wall_reach(std::numeric_limits<double>::infinity()),
-                                  std::span<double>(f.wall_distance(), std::size_t(f.grid().total_cells())), true);
-      }
+      // Over MPI, the blocks this process computes (their ghosts too: a ghost's eddy
+      // viscosity is its neighbour's), each within the closure's reach for its cells.
+      f.wall_distance_from(wall_points_);
     }
   }
 

@@ -51,6 +51,7 @@
 /// fields linear along the normal across level interfaces. Beyond the box's outermost
 /// centres the cell's own value is taken.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -332,8 +333,11 @@ void write_pvtu_piece(const std::filesystem::path& pvtu, const fluid::block_solv
 template <class F, class Rc, class Tu, class Vi, class Fr, class Ti>
 std::size_t write_midplane_csv(const std::filesystem::path& path, const fluid::block_solver<F, Rc, Tu, Vi, Fr, Ti>& s,
                                const midplane_options& opt = {}) {
-  const int a = opt.normal_axis;
-  require(a >= 0 && a < 3, "io::write_midplane_csv: normal_axis must be 0, 1 or 2, got ", a);
+  require(opt.normal_axis >= 0 && opt.normal_axis < 3, "io::write_midplane_csv: normal_axis must be 0, 1 or 2, got ",
+          opt.normal_axis);
+  // The same axis, in a form the compiler sees in range (GCC 12's -Warray-bounds does not
+  // follow the check above through the inlined loops).
+  const int a = std::clamp(opt.normal_axis, 0, 2);
   const double lo = s.layout().lo[std::size_t(a)], hi = s.layout().hi[std::size_t(a)];
   const double xp = std::isnan(opt.position) ? 0.5 * (lo + hi) : opt.position;
   require(xp >= lo && xp <= hi, "io::write_midplane_csv: plane position ", xp, " outside the box [", lo, ", ", hi,

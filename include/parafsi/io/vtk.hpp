@@ -425,8 +425,11 @@ void write_vts(const std::filesystem::path& path, const Solver& s, const vtk_opt
 template <class Solver>
 std::size_t write_midplane_csv(const std::filesystem::path& path, const Solver& s, const midplane_options& opt = {}) {
   const auto& g = s.grid();
-  const int a = opt.normal_axis;
-  require(a >= 0 && a < 3, "io::write_midplane_csv: normal_axis must be 0, 1 or 2, got ", a);
+  require(opt.normal_axis >= 0 && opt.normal_axis < 3, "io::write_midplane_csv: normal_axis must be 0, 1 or 2, got ",
+          opt.normal_axis);
+  // The same axis, in a form the compiler sees in range (GCC 12's -Warray-bounds does not
+  // follow the check above through the inlined loops).
+  const int a = std::clamp(opt.normal_axis, 0, 2);
   const index_t n[3] = {g.n(0), g.n(1), g.n(2)};
   const double lo = g.face(a, 0), hi = g.face(a, n[a]);
   const double xp = std::isnan(opt.position) ? 0.5 * (lo + hi) : opt.position;

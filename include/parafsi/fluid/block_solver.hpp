@@ -662,6 +662,64 @@ class block_solver {
   }
   void step(double dt) { step(dt, plan_motion(dt)); }
 
+  // ------------------------------------------------------------------ level subcycling
+  /// Largest stable step of the coarsest level under level subcycling (step_subcycled):
+  /// level ℓ takes steps of dt / 2^(ℓ − ℓ_min), so dt = CFL / max over blocks of
+  /// 2^(ℓ_min − ℓ) Σ_d (|u_d − w_d| + c)/h_d (viscous limit included as in stable_dt).
+  double stable_dt_subcycled(double cfl = 0.5) const {
+    require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt_subcycled: CFL must be in (0, 1], got ", cfl);
+    rate_.resize(blocks_.size());
+    for_computed([&](index_t id) {
+      const block& b = blocks_[std::size_t(id)];
+      const double* mu_t = nullptr;
+      if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
+      rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
+                                                                 visc_, turb_, mu_t, cfl, b.rate_slots, false);
+    });
+    int lmin = blocks_.empty() ? 0 : blocks_[0].where.level;
+    for (const block& b : blocks_) lmin = std::min(lmin, b.where.level);
+    double lam = 0.0;
+    for (index_t id : computed_)
+      lam = std::max(lam, std::ldexp(rate_[std::size_t(id)], lmin - blocks_[std::size_t(id)].where.level));
+    if (halo_) lam = halo_->max(lam);
+    require(std::isfinite(lam) && lam > 0.0,
+            "fluid::block_solver::stable_dt_subcycled: non-finite wave speed (a cell's state is NaN or infinite, or "
+            "its pressure and density differ in sign)");
+    return cfl / lam;
+  }
+
+  /// One step dt of the coarsest level with level subcycling (Berger & Colella 1989, on
+  /// the leaves): level ℓ takes 2^(ℓ − ℓ_min) steps of dt / 2^(ℓ − ℓ_min), recursively,
+  /// each level's step before the two of the next finer level over the same interval.
+  ///   - A finer neighbour's ghosts are its restriction at the start of the coarse step
+  ///     (it has not advanced yet), in every stage; a coarser neighbour's are prolonged
+  ///     from its state interpolated linearly in time between the start and the end of its
+  ///     step, at the stage's time.
+  ///   - Conservation: each coarse cell at a coarse–fine face is corrected after the finer
+  ///     level's two steps by dt (F̄_c − F̄_f)/Δx (refluxing), F̄_c its own flux weighted by
+  ///     the Runge–Kutta stage weights, F̄_f the area mean of the fine fluxes weighted by
+  ///     the stage weights and dt_f/dt, so mass, momentum and energy are conserved to
+  ///     round-off.
+  ///   - One level: the same operations as step(dt), bit for bit.
+  /// On one process, without face patches (a coupling); the box motion m as in step().
+  void step_subcycled(double dt, const frame::motion& m) {
+    require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step_subcycled: dt must be positive and finite, got ",
+            dt);
+    require(!halo_, "fluid::block_solver::step_subcycled: level subcycling runs on one process only");
+    gathered_ = true;
+    pose_.set_motion(m);
+    prepare_subcycling();
+    sub_.pose0 = pose_;
+    sub_.t0 = t_;
+    advance_level(sub_.lmin, t_, dt, t_, dt);
+    pose_ = sub_.pose0;
+    pose_.advance(dt);
+    t_ += dt;
+    ++steps_;
+    ++cost_steps_;
+  }
+  void step_subcycled(double dt) { step_subcycled(dt, plan_motion(dt)); }
+
   /// Global index of the leaf cell beside cell `global` along `axis` (side 0: low, 1: high)
   /// if it is a cell of the same level (the same block or a same-level neighbour block,
   /// across a periodic axis too); −1 if that side is another level or outside the box.
@@ -1189,10 +1247,11 @@ class block_solver {
 
   /// U⁰ ← U on every block's span from its first to its last interior cell (the update
   /// reads the interior cells only).
-  void save_stage_start() {
+  void save_stage_start() { save_stage_start(computed_); }
+  void save_stage_start(const std::vector<index_t>& ids) {
     const index_t first = blocks::block_index{n_}(0, 0, 0);
     const index_t count = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1 - first;
-    for_computed([&](index_t id) {
+    for_ids(ids, [&](index_t id) {
       block& b = blocks_[std::size_t(id)];
       const auto U = detail::conserved_ptrs(std::as_const(b.U));
       const auto U0 = detail::conserved_ptrs(b.U0);
@@ -1208,12 +1267,8 @@ class block_solver {
   }
 
   // ------------------------------------------------------------------ phases
-  /// dU of one stage at time t on every block, then the coupling's face patches.
-  template <class Patcher>
-  void compute_rhs(double t, int stage, Patcher& patcher) {
-    using detail::timed;
-    const auto geo = detail::geometry(pose_);
-    // One buffer set per thread of the block loop, handed to the serial kernels inside.
+  /// One buffer set per thread of the block loop, handed to the serial kernels inside.
+  void ensure_buffers() {
     bufs_.resize(std::size_t(parallel::max_threads()));
     for (auto& set : bufs_) detail::ensure_row_buffers(set, n_);
     if constexpr (is_viscous) {
@@ -1222,6 +1277,175 @@ class block_solver {
       for (auto& vs : visc_bufs_)
         if (vs.size() < cells) vs.resize(cells, 0.0);
     }
+  }
+
+  /// The weights β_s of the stages' rates in the step, U^{n+1} = U^n + Δt Σ_s β_s L_s, from
+  /// the Shu–Osher form U^(s+1) = a_s U^n + b_s (U^(s) + Δt L_s) (a_s + b_s = 1): ½, ½ for
+  /// SSP-RK2, 1/6, 1/6, 2/3 for SSP-RK3.
+  static constexpr std::array<double, Time::stages> stage_weights() {
+    std::array<double, Time::stages> beta{};
+    for (int s = 0; s < Time::stages; ++s) {
+      for (int j = 0; j < s; ++j) beta[std::size_t(j)] *= Time::b[std::size_t(s)];
+      beta[std::size_t(s)] = Time::b[std::size_t(s)];
+    }
+    return beta;
+  }
+
+  /// Level subcycling's lists for the present mesh: the blocks of each level, the coarser
+  /// blocks each level's ghost plans read (prolonged from), and one accumulator pair per
+  /// coarse–fine correction.
+  void prepare_subcycling() {
+    sub_.lmin = blocks_[0].where.level;
+    sub_.lmax = sub_.lmin;
+    for (const block& b : blocks_) {
+      sub_.lmin = std::min(sub_.lmin, b.where.level);
+      sub_.lmax = std::max(sub_.lmax, b.where.level);
+    }
+    const std::size_t levels = std::size_t(sub_.lmax - sub_.lmin + 1);
+    sub_.level_ids.assign(levels, {});
+    sub_.coarser.assign(levels, {});
+    for (index_t id = 0; id < block_count(); ++id)
+      sub_.level_ids[std::size_t(blocks_[std::size_t(id)].where.level - sub_.lmin)].push_back(id);
+    std::vector<char> mark(blocks_.size(), 0);
+    for (std::size_t l = 1; l < levels; ++l) {
+      std::fill(mark.begin(), mark.end(), 0);
+      for (index_t id : sub_.level_ids[l])
+        blocks::plan_reads(plan_[std::size_t(id)], n_, [&](const blocks::cell_ref& r) {
+          if (blocks_[std::size_t(r.block)].where.level + 1 == blocks_[std::size_t(id)].where.level)
+            mark[std::size_t(r.block)] = 1;
+        });
+      for (index_t id = 0; id < block_count(); ++id)
+        if (mark[std::size_t(id)]) sub_.coarser[l].push_back(id);
+    }
+    sub_.acc_coarse.resize(blocks_.size());
+    sub_.acc_fine.resize(blocks_.size());
+    for (std::size_t id = 0; id < blocks_.size(); ++id) {
+      sub_.acc_coarse[id].assign(5 * corrections_[id].size(), 0.0);
+      sub_.acc_fine[id].assign(5 * corrections_[id].size(), 0.0);
+    }
+  }
+
+  /// Level l's step from T by dt, inside its coarser level's step from Tp by dtp (itself
+  /// for the coarsest level), then the finer level's two steps and the refluxing.
+  void advance_level(int l, double T, double dt, double Tp, double dtp) {
+    const std::size_t li = std::size_t(l - sub_.lmin);
+    const std::vector<index_t>& ids = sub_.level_ids[li];
+    constexpr std::array<double, Time::stages> beta = stage_weights();
+    save_stage_start(ids);
+    for (index_t id : ids)
+      std::fill(sub_.acc_coarse[std::size_t(id)].begin(), sub_.acc_coarse[std::size_t(id)].end(), 0.0);
+    ensure_buffers();
+    for (int s = 0; s < Time::stages; ++s) {
+      const double tau = T + Time::c[std::size_t(s)] * dt;
+      pose_ = sub_.pose0;
+      if (tau != sub_.t0) pose_.advance(tau - sub_.t0);
+      const auto geo = detail::geometry(pose_);
+      // The coarser level at the stage's time, for the prolonged ghosts.
+      double theta = li > 0 ? (tau - Tp) / dtp : 1.0;
+      if (std::fabs(theta - 1.0) < 1e-12) theta = 1.0;
+      if (theta != 1.0) interpolate_coarser(li, theta);
+      detail::timed(times_.fluxes, [&] {
+        for_ids(ids, [&](index_t id) {
+          fill_block_ghosts(id, tau, geo);
+          sweep_block(id, geo);
+        });
+      });
+      if (theta != 1.0) restore_coarser(li);
+      // This stage's fluxes at the coarse–fine faces into the accumulators: this level's
+      // own as the coarse side, and as the fine side of the coarser level's faces.
+      for_ids(ids, [&](index_t id) { accumulate_coarse(id, beta[std::size_t(s)]); });
+      if (li > 0)
+        for_ids(sub_.level_ids[li - 1], [&](index_t id) { accumulate_fine(id, beta[std::size_t(s)] * dt / dtp); });
+      if (sources_on_ || bc_.layer.cells > 0)
+        detail::timed(times_.sources, [&] { for_ids(ids, [&](index_t id) { add_sources(id); }); });
+      update(ids, Time::a[std::size_t(s)], Time::b[std::size_t(s)], dt, T + dt, s + 1 == Time::stages);
+    }
+    if (l < sub_.lmax) {
+      for (index_t id : ids)
+        std::fill(sub_.acc_fine[std::size_t(id)].begin(), sub_.acc_fine[std::size_t(id)].end(), 0.0);
+      advance_level(l + 1, T, 0.5 * dt, T, dt);
+      advance_level(l + 1, T + 0.5 * dt, 0.5 * dt, T, dt);
+      for_ids(ids, [&](index_t id) { reflux(id, dt); });
+    }
+  }
+
+  /// The blocks level li's plans prolong from: their step's end state kept in dU (free
+  /// between their steps) and U set to (1 − θ) U⁰ + θ U.
+  void interpolate_coarser(std::size_t li, double theta) {
+    const index_t first = blocks::block_index{n_}(0, 0, 0);
+    const index_t last = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1;
+    for_ids(sub_.coarser[li], [&](index_t id) {
+      block& b = blocks_[std::size_t(id)];
+      const auto U = detail::conserved_ptrs(b.U);
+      const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
+      const auto keep = detail::conserved_ptrs(b.dU);
+      for (int f = 0; f < 5; ++f)
+        for (index_t c = first; c < last; ++c) {
+          keep[f][c] = U[f][c];
+          U[f][c] = (1.0 - theta) * U0[f][c] + theta * U[f][c];
+        }
+    });
+  }
+  void restore_coarser(std::size_t li) {
+    const index_t first = blocks::block_index{n_}(0, 0, 0);
+    const index_t last = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1;
+    for_ids(sub_.coarser[li], [&](index_t id) {
+      block& b = blocks_[std::size_t(id)];
+      const auto U = detail::conserved_ptrs(b.U);
+      const auto keep = detail::conserved_ptrs(std::as_const(b.dU));
+      for (int f = 0; f < 5; ++f)
+        for (index_t c = first; c < last; ++c) U[f][c] = keep[f][c];
+    });
+  }
+  /// Coarse block id's own fluxes at its coarse–fine faces, weight w.
+  void accumulate_coarse(index_t id, double w) {
+    block& b = blocks_[std::size_t(id)];
+    std::vector<double>& acc = sub_.acc_coarse[std::size_t(id)];
+    const auto& list = corrections_[std::size_t(id)];
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto& fc = list[k];
+      const detail::face_register rc = register_of(b, fc.axis);
+      const auto& coarse = fc.side ? rc.hi : rc.lo;
+      for (int f = 0; f < 5; ++f) acc[5 * k + std::size_t(f)] += w * coarse[f][fc.coarse_face];
+    }
+  }
+  /// The finer blocks' fluxes at coarse block id's coarse–fine faces (area means), weight w.
+  void accumulate_fine(index_t id, double w) {
+    std::vector<double>& acc = sub_.acc_fine[std::size_t(id)];
+    const auto& list = corrections_[std::size_t(id)];
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto& fc = list[k];
+      const detail::face_register rf = register_of(blocks_[std::size_t(fc.fine_block)], fc.axis);
+      const auto& fine = fc.side ? rf.lo : rf.hi;
+      for (int f = 0; f < 5; ++f)
+        acc[5 * k + std::size_t(f)] += w * (0.25 * ((fine[f][fc.fine_face[0]] + fine[f][fc.fine_face[1]]) +
+                                                    (fine[f][fc.fine_face[2]] + fine[f][fc.fine_face[3]])));
+    }
+  }
+  /// Coarse block id after its finer neighbours' steps: each coarse–fine face's flux over
+  /// the step replaced by the finer level's, U += dt σ (F̄_c − F̄_f)/Δx.
+  void reflux(index_t id, double dt) {
+    block& b = blocks_[std::size_t(id)];
+    const auto U = detail::conserved_ptrs(b.U);
+    const std::vector<double>& ac = sub_.acc_coarse[std::size_t(id)];
+    const std::vector<double>& af = sub_.acc_fine[std::size_t(id)];
+    const auto& list = corrections_[std::size_t(id)];
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto& fc = list[k];
+      const double id_c = b.grid.inv_widths(fc.axis)[0];
+      for (int f = 0; f < 5; ++f) {
+        const double Fc = ac[5 * k + std::size_t(f)], Ff = af[5 * k + std::size_t(f)];
+        U[f][fc.cell] += dt * ((fc.side ? Fc - Ff : Ff - Fc) * id_c);
+      }
+    }
+  }
+
+  /// dU of one stage at time t on every block, then the coupling's face patches.
+  template <class Patcher>
+  void compute_rhs(double t, int stage, Patcher& patcher) {
+    using detail::timed;
+    const auto geo = detail::geometry(pose_);
+    ensure_buffers();
     // Each block of `ids` gets its ghosts and then, while they are in cache, its sweeps (the
     // ghosts read other blocks' interior state, which no sweep writes, so the fused order
     // changes no bit). The loop's wall time is split between `boundaries` and `fluxes` in
@@ -2055,8 +2279,11 @@ class block_solver {
   }
 
   void update(double a, double bcoef, double dt, double t_new, bool last) {
+    update(computed_, a, bcoef, dt, t_new, last);
+  }
+  void update(const std::vector<index_t>& ids, double a, double bcoef, double dt, double t_new, bool last) {
     detail::timed(times_.update, [&] {
-      for_computed([&](index_t id) {
+      for_ids(ids, [&](index_t id) {
         costed(id, [&] {
           block& b = blocks_[std::size_t(id)];
           const auto U = detail::conserved_ptrs(b.U);
@@ -2067,7 +2294,7 @@ class block_solver {
         });
       });
       if (last)
-        for (index_t id : computed_) {
+        for (index_t id : ids) {
           const block& b = blocks_[std::size_t(id)];
           detail::check_rows(b.grid, gas_, pose_, detail::conserved_ptrs(std::as_const(b.U)), b.bad_rows.data(), t_new);
         }
@@ -2111,6 +2338,16 @@ class block_solver {
   std::vector<double> share_vals_;
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
+  /// Level subcycling (step_subcycled): the levels, each level's blocks and the coarser
+  /// blocks its ghost plans read, the coarse–fine flux accumulators (5 per correction of
+  /// corrections_), the pose and time at the step's start.
+  struct subcycling {
+    int lmin = 0, lmax = 0;
+    std::vector<std::vector<index_t>> level_ids, coarser;
+    std::vector<std::vector<double>> acc_coarse, acc_fine;
+    frame::pose pose0{};
+    double t0 = 0.0;
+  } sub_;
   blocks::block_fields U_all_;
   std::vector<std::vector<detail::row_buffers>> bufs_;  ///< per thread of the block loop
   std::vector<viscous_storage> visc_bufs_;              ///< per thread of the block loop (viscous)

@@ -194,6 +194,9 @@ int main(int argc, char** argv) {
   app.add_flag("--static-mesh", c.static_mesh,
                "blocks: refine once at the start, to the canopy and the refined column as --refine-column, and "
                "never regrid (the canopy must stay on that column)");
+  app.add_flag("--subcycle", c.subcycle,
+               "blocks: level subcycling, each level at its own CFL step (the finest level, the embedded "
+               "coupling and the structure together; one process)");
   app.add_option("--refine-vorticity", c.refine_vorticity,
                  "blocks: also refine the wake where |vorticity| h exceeds this fraction of the payload speed "
                  "(0: off)")

@@ -157,33 +157,7 @@ class explicit_stepper {
       });
     if constexpr (coupled) timed(times_.exchange, [&] { coupling_.exchange(fluid_, structure_, dt); });
     auto structure_phase = [&] {
-      if constexpr (has_structure) {
-        timed(times_.structure, [&] {
-          double crit = structure_.stable_dt();
-          if constexpr (coupled) crit = std::min(crit, coupling_.structure_dt());
-          const long m = structure::central_difference::substeps(dt, crit);
-          if (m > max_substeps)
-            throw invalid_input(detail::concat("explicit_stepper::step: the structure needs ", m,
-                                               " substeps in a step of ", dt, " s (stable substep ", crit,
-                                               " s, max_substeps = ", max_substeps,
-                                               "); reduce the fluid step or the coupling stiffness (PFAC)"));
-          const double ds = dt / double(m);
-          for (long k = 0; k < m; ++k) {
-            const double prev = prev_substep_ < 0 ? ds : prev_substep_;
-            const double kick = 0.5 * (prev + ds);
-            if constexpr (coupled) {
-              const double tau = double(k) * ds;
-              structure_.step(ds, [&](structure::load_sink& sink, double) {
-                coupling_.apply(sink, structure_.node_set(), tau, kick, ds);
-              });
-            } else {
-              structure_.step(ds);
-            }
-            prev_substep_ = ds;
-          }
-          last_m_ = m;
-        });
-      }
+      if constexpr (has_structure) timed(times_.structure, [&] { last_m_ = structure_substeps(dt); });
     };
     auto fluid_phase = [&] {
       if constexpr (has_fluid) {
@@ -205,7 +179,87 @@ class explicit_stepper {
     ++steps_;
   }
 
+  /// Largest stable step of the coarsest fluid level under level subcycling
+  /// (step_subcycled): the fluid's (fluid::block_solver::stable_dt_subcycled) and the
+  /// coupling's travel limit for each of the finest level's steps, of which there are
+  /// fluid().finest_substeps() in the step.
+  double stable_dt_subcycled(double cfl = 0.5) requires has_fluid {
+    double dt = fluid_.stable_dt_subcycled(cfl);
+    if constexpr (coupled)
+      dt = std::min(dt, coupling_.travel_dt(fluid_, structure_) * double(fluid_.finest_substeps()));
+    return dt;
+  }
+
+  /// One step dt of the coarsest fluid level with level subcycling
+  /// (fluid::block_solver::step_subcycled): the frame moves as in step(); the coupling
+  /// (a fluid_first face patcher: coupling::embedded) finds its faces before each step of
+  /// the finest level, whose stages it patches, and the structure takes its substeps after
+  /// each, so the membrane and the finest level advance together while the coarser levels
+  /// take their longer steps. last_substeps() is then the structure substeps of the whole
+  /// step.
+  /// (Only for a coupling that patches the fluid's faces and runs the fluid first, or none.)
+  void step_subcycled(double dt) requires(has_fluid && (!coupled || (patches_faces && fluid_first))) {
+    require(dt > 0 && std::isfinite(dt), "explicit_stepper::step_subcycled: dt must be > 0 and finite, got ", dt);
+    timed(times_.move_frame, [&] {
+      if constexpr (has_frame_target) target_(fluid_, structure_, dt);
+      motion_ = fluid_.plan_motion(dt);
+      if constexpr (coupled) coupling_.plan(fluid_, motion_);
+    });
+    struct finest_hooks {
+      explicit_stepper& s;
+      long substeps = 0;
+      void before(double, double dt_f) {
+        if constexpr (coupled) {
+          timed(s.times_.exchange, [&] { s.coupling_.exchange(s.fluid_, s.structure_, dt_f); });
+          s.coupling_.finish(s.fluid_, dt_f);
+        }
+      }
+      void after(double, double dt_f) {
+        if constexpr (has_structure) timed(s.times_.structure, [&] { substeps += s.structure_substeps(dt_f); });
+      }
+    } hooks{*this};
+    const double exchange0 = times_.exchange, structure0 = times_.structure;
+    const auto t0 = std::chrono::steady_clock::now();
+    if constexpr (coupled) fluid_.step_subcycled(dt, motion_, coupling_, hooks);
+    else {
+      fluid::no_patches none;
+      fluid_.step_subcycled(dt, motion_, none, hooks);
+    }
+    times_.fluid += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() -
+                    (times_.exchange - exchange0) - (times_.structure - structure0);
+    last_m_ = hooks.substeps;
+    t_ += dt;
+    ++steps_;
+  }
+
  private:
+  /// The structure over dt in m = ceil(dt / Δt_s,crit) equal substeps, the coupling's
+  /// forces in each (their kicks continuing the previous substep's); returns m.
+  long structure_substeps(double dt) {
+    double crit = structure_.stable_dt();
+    if constexpr (coupled) crit = std::min(crit, coupling_.structure_dt());
+    const long m = structure::central_difference::substeps(dt, crit);
+    if (m > max_substeps)
+      throw invalid_input(detail::concat("explicit_stepper::step: the structure needs ", m, " substeps in a step of ",
+                                         dt, " s (stable substep ", crit, " s, max_substeps = ", max_substeps,
+                                         "); reduce the fluid step or the coupling stiffness (PFAC)"));
+    const double ds = dt / double(m);
+    for (long k = 0; k < m; ++k) {
+      const double prev = prev_substep_ < 0 ? ds : prev_substep_;
+      const double kick = 0.5 * (prev + ds);
+      if constexpr (coupled) {
+        const double tau = double(k) * ds;
+        structure_.step(ds, [&](structure::load_sink& sink, double) {
+          coupling_.apply(sink, structure_.node_set(), tau, kick, ds);
+        });
+      } else {
+        structure_.step(ds);
+      }
+      prev_substep_ = ds;
+    }
+    return m;
+  }
+
   template <class F>
   static void timed(double& acc, F&& f) {
     const auto t0 = std::chrono::steady_clock::now();

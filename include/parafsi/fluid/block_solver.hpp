@@ -701,8 +701,14 @@ class block_solver {
   ///     the stage weights and dt_f/dt, so mass, momentum and energy are conserved to
   ///     round-off.
   ///   - One level: the same operations as step(dt), bit for bit.
-  /// On one process, without face patches (a coupling); the box motion m as in step().
-  void step_subcycled(double dt, const frame::motion& m) {
+  ///   - A coupling's face patches (patch.hpp) act in the finest level's stages, and must
+  ///     lie on the finest level; `finest.before(t, dt_f)` is called before each step of
+  ///     the finest level (pose() then that step's start) and `finest.after(t + dt_f,
+  ///     dt_f)` after it, in time order, so a coupling can find its faces and advance the
+  ///     structure with the finest level (explicit_stepper::step_subcycled).
+  /// On one process; the box motion m as in step().
+  template <face_patcher Patcher, class Finest>
+  void step_subcycled(double dt, const frame::motion& m, Patcher& patcher, Finest&& finest) {
     require(dt > 0.0 && std::isfinite(dt), "fluid::block_solver::step_subcycled: dt must be positive and finite, got ",
             dt);
     require(!halo_, "fluid::block_solver::step_subcycled: level subcycling runs on one process only");
@@ -711,14 +717,32 @@ class block_solver {
     prepare_subcycling();
     sub_.pose0 = pose_;
     sub_.t0 = t_;
-    advance_level(sub_.lmin, t_, dt, t_, dt);
+    advance_level(sub_.lmin, t_, dt, t_, dt, patcher, finest);
     pose_ = sub_.pose0;
     pose_.advance(dt);
     t_ += dt;
     ++steps_;
     ++cost_steps_;
   }
+  void step_subcycled(double dt, const frame::motion& m) {
+    no_patches none;
+    step_subcycled(dt, m, none, no_finest_hooks{});
+  }
   void step_subcycled(double dt) { step_subcycled(dt, plan_motion(dt)); }
+  /// step_subcycled's calls around the finest level's steps, when nothing is to be done.
+  struct no_finest_hooks {
+    void before(double, double) const noexcept {}
+    void after(double, double) const noexcept {}
+  };
+  /// The number of finest-level steps in one step_subcycled (2^(finest − coarsest level)).
+  long finest_substeps() const noexcept {
+    int lmin = blocks_.empty() ? 0 : blocks_[0].where.level, lmax = lmin;
+    for (const block& b : blocks_) {
+      lmin = std::min(lmin, b.where.level);
+      lmax = std::max(lmax, b.where.level);
+    }
+    return 1L << (lmax - lmin);
+  }
 
   /// Global index of the leaf cell beside cell `global` along `axis` (side 0: low, 1: high)
   /// if it is a cell of the same level (the same block or a same-level neighbour block,
@@ -1327,10 +1351,22 @@ class block_solver {
 
   /// Level l's step from T by dt, inside its coarser level's step from Tp by dtp (itself
   /// for the coarsest level), then the finer level's two steps and the refluxing.
-  void advance_level(int l, double T, double dt, double Tp, double dtp) {
+  template <class Patcher, class Finest>
+  void advance_level(int l, double T, double dt, double Tp, double dtp, Patcher& patcher, Finest& finest) {
     const std::size_t li = std::size_t(l - sub_.lmin);
     const std::vector<index_t>& ids = sub_.level_ids[li];
     constexpr std::array<double, Time::stages> beta = stage_weights();
+    const bool finest_level = l == sub_.lmax;
+    if (finest_level) {
+      pose_ = sub_.pose0;
+      if (T != sub_.t0) pose_.advance(T - sub_.t0);
+      finest.before(T, dt);
+      for (const patch_face& f : patcher.patch_faces())
+        require(f.high >= 0 && f.high < stride_ * block_count() &&
+                    blocks_[std::size_t(f.high / stride_)].where.level == sub_.lmax,
+                "fluid::block_solver::step_subcycled: a patched face (cell ", f.high,
+                ") is not on the finest level: the membrane must lie on the finest level (refine around it)");
+    }
     save_stage_start(ids);
     for (index_t id : ids)
       std::fill(sub_.acc_coarse[std::size_t(id)].begin(), sub_.acc_coarse[std::size_t(id)].end(), 0.0);
@@ -1356,15 +1392,18 @@ class block_solver {
       for_ids(ids, [&](index_t id) { accumulate_coarse(id, beta[std::size_t(s)]); });
       if (li > 0)
         for_ids(sub_.level_ids[li - 1], [&](index_t id) { accumulate_fine(id, beta[std::size_t(s)] * dt / dtp); });
+      if (finest_level && !patcher.patch_faces().empty())
+        detail::timed(times_.fluxes, [&] { patch_faces(geo, s, patcher); });
       if (sources_on_ || bc_.layer.cells > 0)
         detail::timed(times_.sources, [&] { for_ids(ids, [&](index_t id) { add_sources(id); }); });
       update(ids, Time::a[std::size_t(s)], Time::b[std::size_t(s)], dt, T + dt, s + 1 == Time::stages);
     }
+    if (finest_level) finest.after(T + dt, dt);
     if (l < sub_.lmax) {
       for (index_t id : ids)
         std::fill(sub_.acc_fine[std::size_t(id)].begin(), sub_.acc_fine[std::size_t(id)].end(), 0.0);
-      advance_level(l + 1, T, 0.5 * dt, T, dt);
-      advance_level(l + 1, T + 0.5 * dt, 0.5 * dt, T, dt);
+      advance_level(l + 1, T, 0.5 * dt, T, dt, patcher, finest);
+      advance_level(l + 1, T + 0.5 * dt, 0.5 * dt, T, dt, patcher, finest);
       for_ids(ids, [&](index_t id) { reflux(id, dt); });
     }
   }

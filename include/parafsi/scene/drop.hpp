@@ -112,6 +112,10 @@ struct drop_config {
   /// --refine-column's first mesh), and never regrid: a mesh that stays (the membrane must
   /// stay on the column's finest level, or the coupling stops the run)
   bool static_mesh = false;
+  /// blocks: level subcycling (fluid::block_solver::step_subcycled): each level steps at its
+  /// own CFL limit, the finest level, the coupling and the structure together (embedded
+  /// coupling, one process)
+  bool subcycle = false;
   /// constant | inviscid | auto (constant with a closure; without one inviscid at draft/coarse/tiny)
   std::string viscosity = "auto";
   /// The wake's eddy-viscosity closure: none | mixing_length (Prandtl's, the method's,
@@ -202,7 +206,11 @@ struct drop_config {
       require(refine_vorticity == 0, "parachute_drop: --refine-vorticity needs --mesh blocks");
       require(!refine_column, "parachute_drop: --refine-column needs --mesh blocks");
       require(!static_mesh, "parachute_drop: --static-mesh needs --mesh blocks");
+      require(!subcycle, "parachute_drop: --subcycle needs --mesh blocks");
     }
+    require(!subcycle || coupling == "embedded",
+            "parachute_drop: --subcycle needs the embedded coupling (its faces and the structure advance with the "
+            "finest level)");
     const std::pair<const char*, double> numbers[] = {{"t_end", t_end},
                                                       {"history_every", history_every},
                                                       {"force_cutoff", force_cutoff},
@@ -394,6 +402,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
         .add("refine_vorticity", c.refine_vorticity)
         .add("refine_column", std::int64_t(c.refine_column));
   if (c.mesh == "blocks" && c.static_mesh) g.add("static_mesh", std::int64_t(1));
+  if (c.mesh == "blocks" && c.subcycle) g.add("subcycle", std::int64_t(1));
   if (c.mesh == "blocks" && c.root_blocks != 2) g.add("root_blocks", std::int64_t(c.root_blocks));
   return g;
 }
@@ -407,6 +416,8 @@ class drop_run {
  public:
   using stepper_type = explicit_stepper<Fluid, structure::drop_assembly, Coupling, drop_frame_target_t<Fluid>>;
   static constexpr bool block_mesh = coupling::block_fluid<Fluid>;
+  /// Level subcycling is possible: a block mesh and a coupling that patches its faces.
+  static constexpr bool can_subcycle = block_mesh && requires(stepper_type & s) { s.step_subcycled(1.0); };
 
   /// `levels`: the block mesh's finest level (block meshes only).
   drop_run(const drop_config& c, const drop_setup& su, Fluid&& f, structure::drop_assembly&& a, Coupling&& cpl,
@@ -530,6 +541,8 @@ class drop_run {
       write_slice(0.0);
       ++next_slice;
     }
+    require(!c_.subcycle || !c_.halo,
+            "parachute_drop: --subcycle runs on one process (level subcycling is not distributed yet)");
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
       if constexpr (block_mesh) {
@@ -540,7 +553,12 @@ class drop_run {
       const double dt = next_step(std::min(next_out, c_.t_end));
       check_fixed_box();
       update_wall_distance();
-      s_.step(dt);
+      if constexpr (can_subcycle) {
+        if (c_.subcycle) s_.step_subcycled(dt);
+        else s_.step(dt);
+      } else {
+        s_.step(dt);
+      }
       if constexpr (block_mesh) {
         cell_steps_ += double(s_.fluid().cell_count());
         ++counted_steps_;
@@ -769,7 +787,9 @@ class drop_run {
 
   /// The stable step, refused when it collapses, shortened to land on `target`.
   double next_step(double target) {
-    const double dt = s_.stable_dt(c_.cfl);
+    double dt = 0;
+    if constexpr (can_subcycle) dt = c_.subcycle ? s_.stable_dt_subcycled(c_.cfl) : s_.stable_dt(c_.cfl);
+    else dt = s_.stable_dt(c_.cfl);
     if (!(dt > 1e-9 * c_.history_every) || !std::isfinite(dt))
       throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt, " s at t = ",
                                                       s_.time(), " s (coupling ", c_.coupling, "); stopping"),

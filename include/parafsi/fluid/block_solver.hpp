@@ -1316,7 +1316,7 @@ class block_solver {
   }
 
   /// Level subcycling's lists for the present mesh: the blocks of each level, the coarser
-  /// blocks each level's ghost plans read (prolonged from), and one accumulator pair per
+  /// cells each level's ghost plans read (prolonged from), and one accumulator pair per
   /// coarse–fine correction.
   void prepare_subcycling() {
     sub_.lmin = blocks_[0].where.level;
@@ -1330,16 +1330,15 @@ class block_solver {
     sub_.coarser.assign(levels, {});
     for (index_t id = 0; id < block_count(); ++id)
       sub_.level_ids[std::size_t(blocks_[std::size_t(id)].where.level - sub_.lmin)].push_back(id);
-    std::vector<char> mark(blocks_.size(), 0);
     for (std::size_t l = 1; l < levels; ++l) {
-      std::fill(mark.begin(), mark.end(), 0);
+      std::vector<index_t>& cells = sub_.coarser[l];
       for (index_t id : sub_.level_ids[l])
         blocks::plan_reads(plan_[std::size_t(id)], n_, [&](const blocks::cell_ref& r) {
           if (blocks_[std::size_t(r.block)].where.level + 1 == blocks_[std::size_t(id)].where.level)
-            mark[std::size_t(r.block)] = 1;
+            cells.push_back(global_index(r.block, r.cell));
         });
-      for (index_t id = 0; id < block_count(); ++id)
-        if (mark[std::size_t(id)]) sub_.coarser[l].push_back(id);
+      std::sort(cells.begin(), cells.end());
+      cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     }
     sub_.acc_coarse.resize(blocks_.size());
     sub_.acc_fine.resize(blocks_.size());
@@ -1408,33 +1407,31 @@ class block_solver {
     }
   }
 
-  /// The blocks level li's plans prolong from: their step's end state kept in dU (free
-  /// between their steps) and U set to (1 − θ) U⁰ + θ U.
+  /// The coarser cells level li's plans prolong from (sub_.coarser): their step's end
+  /// state kept aside and U set to (1 − θ) U⁰ + θ U.
   void interpolate_coarser(std::size_t li, double theta) {
-    const index_t first = blocks::block_index{n_}(0, 0, 0);
-    const index_t last = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1;
-    for_ids(sub_.coarser[li], [&](index_t id) {
-      block& b = blocks_[std::size_t(id)];
-      const auto U = detail::conserved_ptrs(b.U);
-      const auto U0 = detail::conserved_ptrs(std::as_const(b.U0));
-      const auto keep = detail::conserved_ptrs(b.dU);
-      for (int f = 0; f < 5; ++f)
-        for (index_t c = first; c < last; ++c) {
-          keep[f][c] = U[f][c];
-          U[f][c] = (1.0 - theta) * U0[f][c] + theta * U[f][c];
-        }
-    });
+    const std::vector<index_t>& cells = sub_.coarser[li];
+    sub_.kept.resize(5 * cells.size());
+    double* U[5];
+    const double* U0[5];
+    for (std::size_t f = 0; f < 5; ++f) {
+      U[f] = U_->data(f);
+      U0[f] = U0_->data(f);
+    }
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const index_t g = cells[k];
+      for (std::size_t f = 0; f < 5; ++f) {
+        sub_.kept[5 * k + f] = U[f][g];
+        U[f][g] = (1.0 - theta) * U0[f][g] + theta * U[f][g];
+      }
+    }
   }
   void restore_coarser(std::size_t li) {
-    const index_t first = blocks::block_index{n_}(0, 0, 0);
-    const index_t last = blocks::block_index{n_}(n_ - 1, n_ - 1, n_ - 1) + 1;
-    for_ids(sub_.coarser[li], [&](index_t id) {
-      block& b = blocks_[std::size_t(id)];
-      const auto U = detail::conserved_ptrs(b.U);
-      const auto keep = detail::conserved_ptrs(std::as_const(b.dU));
-      for (int f = 0; f < 5; ++f)
-        for (index_t c = first; c < last; ++c) U[f][c] = keep[f][c];
-    });
+    const std::vector<index_t>& cells = sub_.coarser[li];
+    for (std::size_t f = 0; f < 5; ++f) {
+      double* U = U_->data(f);
+      for (std::size_t k = 0; k < cells.size(); ++k) U[cells[k]] = sub_.kept[5 * k + f];
+    }
   }
   /// Coarse block id's own fluxes at its coarse–fine faces, weight w.
   void accumulate_coarse(index_t id, double w) {
@@ -2378,11 +2375,13 @@ class block_solver {
   std::vector<blocks::block_plan> plan_;
   std::vector<std::vector<blocks::flux_correction>> corrections_;
   /// Level subcycling (step_subcycled): the levels, each level's blocks and the coarser
-  /// blocks its ghost plans read, the coarse–fine flux accumulators (5 per correction of
-  /// corrections_), the pose and time at the step's start.
+  /// cells its ghost plans read (global indices), the latter's end states while they are
+  /// interpolated, the coarse–fine flux accumulators (5 per correction of corrections_),
+  /// the pose and time at the step's start.
   struct subcycling {
     int lmin = 0, lmax = 0;
     std::vector<std::vector<index_t>> level_ids, coarser;
+    std::vector<double> kept;
     std::vector<std::vector<double>> acc_coarse, acc_fine;
     frame::pose pose0{};
     double t0 = 0.0;

@@ -118,6 +118,18 @@ TEST_CASE("a coupled step with the one-sided embedded coupling on three levels o
   CHECK(s.fluid().tree().finest_level() == 2);
 }
 
+TEST_CASE("a subcycled coupled step (one-sided embedded coupling, levels 1-2 of blocks) allocates nothing") {
+  auto s = ctu::blocks_patch(2, pf::coupling::embedded<pf::porosity::impermeable, true>{pf::porosity::impermeable{}});
+  for (int k = 0; k < 2; ++k) s.step_subcycled(s.stable_dt_subcycled(0.5));
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 4; ++k) s.step_subcycled(s.stable_dt_subcycled(0.5));
+  g_counting = false;
+  CHECK(g_allocations.load() == 0);
+  CHECK(s.coupling().diagnostics().faces > 0);
+  CHECK(s.fluid().finest_substeps() == 2);
+}
+
 TEST_CASE("a fluid-only step (viscous, turbulent, sponge, sources, moving box) allocates nothing after warm-up") {
   auto bc = pf::boundary::set::all(pf::boundary::far_field{1.2, {5.0, 0, 0}, 101325.0});
   bc.layer = {2, 0.5};

@@ -1054,6 +1054,7 @@ class block_solver {
     attach_slices();
     plan_ = blocks::build_plan(tree_, n_, /*edges=*/is_viscous);
     corrections_ = blocks::build_flux_corrections(tree_, n_);
+    sub_.ready = false;  // level subcycling's lists follow the mesh
     threaded_ = cell_count() >= 32768 && nleaf >= 2;
     attach_halo();
     for_computed([&](index_t id) { initialize_block_storage(id); });
@@ -1319,6 +1320,8 @@ class block_solver {
   /// cells each level's ghost plans read (prolonged from), and one accumulator pair per
   /// coarse–fine correction.
   void prepare_subcycling() {
+    if (sub_.ready) return;
+    sub_.ready = true;
     sub_.lmin = blocks_[0].where.level;
     sub_.lmax = sub_.lmin;
     for (const block& b : blocks_) {
@@ -2379,6 +2382,7 @@ class block_solver {
   /// interpolated, the coarse–fine flux accumulators (5 per correction of corrections_),
   /// the pose and time at the step's start.
   struct subcycling {
+    bool ready = false;  ///< the lists describe the present mesh
     int lmin = 0, lmax = 0;
     std::vector<std::vector<index_t>> level_ids, coarser;
     std::vector<double> kept;

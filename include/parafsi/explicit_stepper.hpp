@@ -196,7 +196,8 @@ class explicit_stepper {
   /// the finest level, whose stages it patches, and the structure takes its substeps after
   /// each, so the membrane and the finest level advance together while the coarser levels
   /// take their longer steps. last_substeps() is then the structure substeps of the whole
-  /// step.
+  /// step; the coupling's diagnostics (faces, impulse, work, through-flow) describe the
+  /// last step of the finest level, as its exchange starts them anew.
   /// (Only for a coupling that patches the fluid's faces and runs the fluid first, or none.)
   void step_subcycled(double dt) requires(has_fluid && (!coupled || (patches_faces && fluid_first))) {
     require(dt > 0 && std::isfinite(dt), "explicit_stepper::step_subcycled: dt must be > 0 and finite, got ", dt);

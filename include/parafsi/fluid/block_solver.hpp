@@ -700,7 +700,9 @@ class block_solver {
   ///     the Runge–Kutta stage weights, F̄_f the area mean of the fine fluxes weighted by
   ///     the stage weights and dt_f/dt, so mass, momentum and energy are conserved to
   ///     round-off.
-  ///   - One level: the same operations as step(dt), bit for bit.
+  ///   - One level: the same operations as step(dt) (bit for bit with SSP-RK2 in a fixed
+  ///     frame; on a moving box the stage poses are advanced from the step's start, which
+  ///     can differ from step()'s in the last bits).
   ///   - A coupling's face patches (patch.hpp) act in the finest level's stages, and must
   ///     lie on the finest level; `finest.before(t, dt_f)` is called before each step of
   ///     the finest level (pose() then that step's start) and `finest.after(t + dt_f,
@@ -1407,6 +1409,31 @@ class block_solver {
       advance_level(l + 1, T, 0.5 * dt, T, dt, patcher, finest);
       advance_level(l + 1, T + 0.5 * dt, 0.5 * dt, T, dt, patcher, finest);
       for_ids(ids, [&](index_t id) { reflux(id, dt); });
+      check_refluxed(ids, T + dt);
+    }
+  }
+
+  /// The refluxed cells of blocks `ids` still a gas (ρ > 0, p > 0), or a message naming one.
+  void check_refluxed(const std::vector<index_t>& ids, double t) const {
+    for (index_t id : ids) {
+      const block& b = blocks_[std::size_t(id)];
+      const auto U = detail::conserved_ptrs(std::as_const(b.U));
+      for (const auto& fc : corrections_[std::size_t(id)]) {
+        const auto q = detail::load_cons(U, fc.cell);
+        const double p = gas_.pressure(q.rho, q.m.x, q.m.y, q.m.z, q.E);
+        if (!(q.rho > 0.0) || !(p > 0.0) || !std::isfinite(p)) {
+          const auto ijk = b.grid.ijk(fc.cell);
+          const Eigen::Vector3d x = pose_.to_inertial(
+              {b.grid.centre(0, ijk[0]), b.grid.centre(1, ijk[1]), b.grid.centre(2, ijk[2])});
+          throw numerical_failure(
+              parafsi::detail::concat("fluid::block_solver::step_subcycled: non-physical state after the coarse-fine "
+                                      "flux correction in block ",
+                                      id, " cell (", ijk[0], ", ", ijk[1], ", ", ijk[2], ") at x = (", x[0], ", ", x[1],
+                                      ", ", x[2], ") m, t = ", t, " s: rho = ", q.rho, " kg/m^3, p = ", p,
+                                      " Pa; reduce the time step (CFL)"),
+              global_index(id, fc.cell), t);
+        }
+      }
     }
   }
 

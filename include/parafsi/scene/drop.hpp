@@ -208,6 +208,9 @@ struct drop_config {
       require(!static_mesh, "parachute_drop: --static-mesh needs --mesh blocks");
       require(!subcycle, "parachute_drop: --subcycle needs --mesh blocks");
     }
+    require(!subcycle || !halo,
+            "parachute_drop: --subcycle runs on one process, without mpirun (level subcycling is not distributed "
+            "yet)");
     require(!subcycle || coupling == "embedded",
             "parachute_drop: --subcycle needs the embedded coupling (its faces and the structure advance with the "
             "finest level)");
@@ -541,8 +544,6 @@ class drop_run {
       write_slice(0.0);
       ++next_slice;
     }
-    require(!c_.subcycle || !c_.halo,
-            "parachute_drop: --subcycle runs on one process (level subcycling is not distributed yet)");
     long substeps = 0;
     while (s_.time() < c_.t_end - 1e-12) {
       if constexpr (block_mesh) {
@@ -726,8 +727,11 @@ class drop_run {
   void regrid() {
     if constexpr (block_mesh) {
       auto& f = s_.fluid();
+      // Subcycled, a step of the coarsest level holds up to 2^levels steps of the finest,
+      // each of which the coupling's travel limit allows: the buffer counts those.
+      const int finest_steps = c_.refine_every * (c_.subcycle ? 1 << levels_ : 1);
       const auto canopy = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
-                                            levels_, c_.refine_every);
+                                            levels_, finest_steps);
       const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column || c_.static_mesh ? levels_ : 0);
       const auto near = fluid::blocks::max_of{canopy, column};
       bool changed = false;

@@ -69,9 +69,11 @@ inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_bo
 /// The block mesh's refinement target for a drop: the finest level `level` within a buffer of
 /// the canopy's nodes (box coordinates of fluid `f`'s pose), graded outwards (each coarser
 /// level twice as far). The buffer is the canopy's longest element edge now plus
-/// (refine_every + 2) finest cells: a node moves at most one cell per step relative to the
-/// box (the coupling's travel limit), so until the next regrid every cell the canopy cuts,
-/// with its interpolation stencil, stays on the finest level.
+/// (refine_every + 2) finest cells: a node moves at most one cell per step of the finest
+/// level relative to the box (the coupling's travel limit), so until the next regrid every
+/// cell the canopy cuts, with its interpolation stencil, stays on the finest level
+/// (`refine_every`: the finest level's steps between regrids, 2^levels per step when the
+/// levels are subcycled).
 template <class Fluid>
 fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f, const structure::nodes& nd,
                                                                   index_t canopy_nodes,

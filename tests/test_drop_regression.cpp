@@ -18,6 +18,20 @@
 
 using doctest::Approx;
 
+namespace {
+/// History values that differ between two runs of equal length (NaN equals NaN).
+template <class Rows>
+std::size_t differing_values(const Rows& x, const Rows& y) {
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const auto a = x[i].values(), b = y[i].values();
+    for (std::size_t k = 0; k < a.size(); ++k)
+      if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
+  }
+  return differing;
+}
+}  // namespace
+
 TEST_CASE("drop regression: tiny grid, 0.25 s from 8 m/s") {
   parafsi::parallel::set_threads(1);
   parafsi::scene::drop_config c;
@@ -100,13 +114,7 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
 
     REQUIRE(full.history.size() == 21);
     REQUIRE(cont.history.size() == full.history.size());
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < full.history.size(); ++i) {
-      const auto a = full.history[i].values(), b = cont.history[i].values();
-      for (std::size_t k = 0; k < a.size(); ++k)
-        if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
-    }
-    CHECK(differing == 0);
+    CHECK(differing_values(full.history, cont.history) == 0);
     CHECK(cont.history.back().t == full.history.back().t);
     CHECK(cont.summary.F_p == full.summary.F_p);
     CHECK(cont.summary.t_p == full.summary.t_p);
@@ -173,7 +181,7 @@ TEST_CASE("drop on blocks with level subcycling: fewer, longer steps; a restart 
   MESSAGE("tiny drop on blocks, 0.04 s: ", one_rate.steps, " steps, subcycled ", full.steps,
           " coarse steps; speed at 0.04 s ", one_rate.history.back().speed, " and ", full.history.back().speed, " m/s");
   CHECK(full.steps < one_rate.steps);
-  CHECK(full.history.back().speed == doctest::Approx(one_rate.history.back().speed).epsilon(0.01));
+  CHECK(full.history.back().speed == doctest::Approx(one_rate.history.back().speed).epsilon(1e-3));
 
   fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
   c.out = (base / "b").string();
@@ -181,13 +189,7 @@ TEST_CASE("drop on blocks with level subcycling: fewer, longer steps; a restart 
   c.restart = (base / "b" / "checkpoint.ckpt").string();
   const auto cont = parafsi::scene::run_drop(c);
   REQUIRE(cont.history.size() == full.history.size());
-  std::size_t differing = 0;
-  for (std::size_t i = 0; i < full.history.size(); ++i) {
-    const auto a = full.history[i].values(), b = cont.history[i].values();
-    for (std::size_t k = 0; k < a.size(); ++k)
-      if (!(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))) ++differing;
-  }
-  CHECK(differing == 0);
+  CHECK(differing_values(full.history, cont.history) == 0);
   CHECK(cont.steps == full.steps);
   // Subcycling needs the embedded coupling (its faces and the structure advance with the
   // finest level) and the block mesh.

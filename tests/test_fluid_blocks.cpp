@@ -50,6 +50,24 @@ template <class S>
 void run_steps(S& s, int steps, double cfl = 0.5) {
   for (int n = 0; n < steps; ++n) s.step(s.stable_dt(cfl));
 }
+
+/// Level 2 on the blocks within 1 of a vortex moving with (u_inf, v_inf) from (cx, cy) on
+/// the periodic 10 × 10 layout `lay`, level 1 within 2.5, at the solver's time.
+template <class S>
+auto moving_vortex_target(const S& s, const fluid::block_layout& lay, const fluid::reference::isentropic_vortex& v) {
+  return [&s, &lay, v](const fb::location& q) {
+    const double t = s.time();
+    const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
+    double d2 = 0;
+    for (int d = 0; d < 2; ++d) {
+      const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
+      double e = std::clamp(c[d], a, a + w) - c[d];
+      e -= 10.0 * std::round(e / 10.0);
+      d2 += e * e;
+    }
+    return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
+  };
+}
 }  // namespace
 
 TEST_CASE(
@@ -327,18 +345,7 @@ TEST_CASE(
     mv.v_inf = 1.0;
     fluid::block_solver s{fb::tree({4, 4, 1}, {true, true, true}), lay, boundary::set::all(boundary::periodic{}),
                           recon::muscl<limiter::mc>{}};
-    auto target = [&](const fb::location& q) {
-      const double t = s.time();
-      const Eigen::Vector3d c(std::fmod(mv.cx + mv.u_inf * t, 10.0), std::fmod(mv.cy + mv.v_inf * t, 10.0), 1.25);
-      double d2 = 0;
-      for (int d = 0; d < 2; ++d) {
-        const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
-        double e = std::clamp(c[d], a, a + w) - c[d];
-        e -= 10.0 * std::round(e / 10.0);
-        d2 += e * e;
-      }
-      return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
-    };
+    const auto target = moving_vortex_target(s, lay, mv);
     s.initialize([&](const Eigen::Vector3d& x) { return mv(x[0], x[1]); });
     s.regrid(target, 2);
     s.initialize([&](const Eigen::Vector3d& x) { return mv(x[0], x[1]); });
@@ -457,18 +464,7 @@ TEST_CASE("regrid: the refined region follows a moving vortex, conserving to rou
   fluid::block_solver s{fb::tree({4, 4, 1}, {true, true, true}), lay, boundary::set::all(boundary::periodic{}),
                         recon::muscl<limiter::mc>{}};
   // Target: level 2 on blocks within 1 of the vortex centre, level 1 within 2.5.
-  auto target = [&](const fb::location& q) {
-    const double t = s.time();
-    const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
-    double d2 = 0;
-    for (int d = 0; d < 2; ++d) {
-      const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
-      double e = std::clamp(c[d], a, a + w) - c[d];
-      e -= 10.0 * std::round(e / 10.0);
-      d2 += e * e;
-    }
-    return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
-  };
+  const auto target = moving_vortex_target(s, lay, v);
   s.initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });
   s.regrid(target, 2);
   s.initialize([&](const Eigen::Vector3d& x) { return v(x[0], x[1]); });

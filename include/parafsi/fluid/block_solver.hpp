@@ -602,24 +602,7 @@ class block_solver {
 
   // ------------------------------------------------------------------ stepping
   /// Largest stable step over all blocks: CFL / max Σ_d (|u_d − w_d| + c)/h_d.
-  double stable_dt(double cfl = 0.5) const {
-    require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt: CFL must be in (0, 1], got ", cfl);
-    rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
-    for_computed([&](index_t id) {
-      const block& b = blocks_[std::size_t(id)];
-      const double* mu_t = nullptr;
-      if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
-      rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
-                                                                 visc_, turb_, mu_t, cfl, b.rate_slots, false);
-    });
-    double lam = 0.0;
-    for (index_t id : computed_) lam = std::max(lam, rate_[std::size_t(id)]);
-    if (halo_) lam = halo_->max(lam);  // exact: every process takes the same step
-    require(std::isfinite(lam) && lam > 0.0,
-            "fluid::block_solver::stable_dt: non-finite wave speed (a cell's state is NaN or infinite, or its pressure "
-            "and density differ in sign)");
-    return cfl / lam;
-  }
+  double stable_dt(double cfl = 0.5) const { return cfl / max_rate(cfl, false, "stable_dt"); }
 
   frame::motion plan_motion(double dt) const {
     frame::pose p = pose_;
@@ -666,27 +649,7 @@ class block_solver {
   /// Largest stable step of the coarsest level under level subcycling (step_subcycled):
   /// level ℓ takes steps of dt / 2^(ℓ − ℓ_min), so dt = CFL / max over blocks of
   /// 2^(ℓ_min − ℓ) Σ_d (|u_d − w_d| + c)/h_d (viscous limit included as in stable_dt).
-  double stable_dt_subcycled(double cfl = 0.5) const {
-    require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::stable_dt_subcycled: CFL must be in (0, 1], got ", cfl);
-    rate_.resize(blocks_.size());
-    for_computed([&](index_t id) {
-      const block& b = blocks_[std::size_t(id)];
-      const double* mu_t = nullptr;
-      if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
-      rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
-                                                                 visc_, turb_, mu_t, cfl, b.rate_slots, false);
-    });
-    int lmin = blocks_.empty() ? 0 : blocks_[0].where.level;
-    for (const block& b : blocks_) lmin = std::min(lmin, b.where.level);
-    double lam = 0.0;
-    for (index_t id : computed_)
-      lam = std::max(lam, std::ldexp(rate_[std::size_t(id)], lmin - blocks_[std::size_t(id)].where.level));
-    if (halo_) lam = halo_->max(lam);
-    require(std::isfinite(lam) && lam > 0.0,
-            "fluid::block_solver::stable_dt_subcycled: non-finite wave speed (a cell's state is NaN or infinite, or "
-            "its pressure and density differ in sign)");
-    return cfl / lam;
-  }
+  double stable_dt_subcycled(double cfl = 0.5) const { return cfl / max_rate(cfl, true, "stable_dt_subcycled"); }
 
   /// One step dt of the coarsest level with level subcycling (Berger & Colella 1989, on
   /// the leaves): level ℓ takes 2^(ℓ − ℓ_min) steps of dt / 2^(ℓ − ℓ_min), recursively,
@@ -738,12 +701,17 @@ class block_solver {
   };
   /// The number of finest-level steps in one step_subcycled (2^(finest − coarsest level)).
   long finest_substeps() const noexcept {
+    const auto [lmin, lmax] = level_range();
+    return 1L << (lmax - lmin);
+  }
+  /// The coarsest and finest levels of the leaves.
+  std::pair<int, int> level_range() const noexcept {
     int lmin = blocks_.empty() ? 0 : blocks_[0].where.level, lmax = lmin;
     for (const block& b : blocks_) {
       lmin = std::min(lmin, b.where.level);
       lmax = std::max(lmax, b.where.level);
     }
-    return 1L << (lmax - lmin);
+    return {lmin, lmax};
   }
 
   /// Global index of the leaf cell beside cell `global` along `axis` (side 0: low, 1: high)
@@ -1294,6 +1262,31 @@ class block_solver {
   }
 
   // ------------------------------------------------------------------ phases
+  /// max over the blocks this process computes (all processes: a reduction) of the wave
+  /// rate Σ_d (|u_d − w_d| + c)/h_d with the viscous limit, each block's scaled by
+  /// 2^(ℓ_min − ℓ) when the levels are subcycled (its step is 2^(ℓ − ℓ_min) times shorter).
+  double max_rate(double cfl, bool subcycled, const char* who) const {
+    require(cfl > 0.0 && cfl <= 1.0, "fluid::block_solver::", who, ": CFL must be in (0, 1], got ", cfl);
+    rate_.resize(blocks_.size());  // no allocation once sized (per-block row slots likewise)
+    for_computed([&](index_t id) {
+      const block& b = blocks_[std::size_t(id)];
+      const double* mu_t = nullptr;
+      if constexpr (has_eddy_viscosity) mu_t = b.T.template get<field::mu_t>();
+      rate_[std::size_t(id)] = detail::max_wave_rate<is_viscous>(b.grid, gas_, pose_, detail::conserved_ptrs(b.U),
+                                                                 visc_, turb_, mu_t, cfl, b.rate_slots, false);
+    });
+    const int lmin = subcycled ? level_range().first : 0;
+    double lam = 0.0;
+    for (index_t id : computed_) {
+      const double r = rate_[std::size_t(id)];
+      lam = std::max(lam, subcycled ? std::ldexp(r, lmin - blocks_[std::size_t(id)].where.level) : r);
+    }
+    if (halo_) lam = halo_->max(lam);  // exact: every process takes the same step
+    require(std::isfinite(lam) && lam > 0.0, "fluid::block_solver::", who,
+            ": non-finite wave speed (a cell's state is NaN or infinite, or its pressure and density differ in sign)");
+    return lam;
+  }
+
   /// One buffer set per thread of the block loop, handed to the serial kernels inside.
   void ensure_buffers() {
     bufs_.resize(std::size_t(parallel::max_threads()));
@@ -1324,12 +1317,7 @@ class block_solver {
   void prepare_subcycling() {
     if (sub_.ready) return;
     sub_.ready = true;
-    sub_.lmin = blocks_[0].where.level;
-    sub_.lmax = sub_.lmin;
-    for (const block& b : blocks_) {
-      sub_.lmin = std::min(sub_.lmin, b.where.level);
-      sub_.lmax = std::max(sub_.lmax, b.where.level);
-    }
+    std::tie(sub_.lmin, sub_.lmax) = level_range();
     const std::size_t levels = std::size_t(sub_.lmax - sub_.lmin + 1);
     sub_.level_ids.assign(levels, {});
     sub_.coarser.assign(levels, {});

@@ -16,6 +16,7 @@
 #include <parafsi/model/drop_scene.hpp>
 #include <parafsi/model/duct_screen.hpp>
 #include <parafsi/scene/drop_steps.hpp>
+#include <parafsi/structure/nodes.hpp>
 
 namespace pf = parafsi;
 namespace md = parafsi::model;
@@ -454,6 +455,30 @@ TEST_CASE("drop box as blocks: the finest cell is h, the root blocks cover the b
   check(16, 2, 1, 3);  // the same root width with one level less
   check(16, 1, 2, 2);  // root blocks of 4.27 m: 2 across, the levels of the 8-cell blocks
   CHECK_THROWS_WITH_AS(pf::scene::make_drop_blocks(b, 8, 0), doctest::Contains("across >= 1"), pf::invalid_input);
+}
+
+TEST_CASE("drop canopy travel: the travel limit's cells, or twice the fastest node's path over the window plus one") {
+  // A fluid's layout and pose are all the bound reads: blocks of 8 cells, h = 0.05 m on level 2.
+  struct fluid_like {
+    pf::fluid::block_layout lay{{-2.4, -2.4, -2.4}, {2.4, 2.4, 2.4}, {3, 3, 3}, 8};
+    pf::frame::pose p;
+    const pf::fluid::block_layout& layout() const { return lay; }
+    const pf::frame::pose& pose() const { return p; }
+  } f;
+  f.p.V = Eigen::Vector3d(0, 0, -5);     // the box falls at 5 m/s
+  f.p.Omega = Eigen::Vector3d(0, 0, 2);  // and turns about its z axis at 2 rad/s
+  const double h = f.lay.cell_width(0, 2);
+  REQUIRE(h == doctest::Approx(0.05));
+  pf::structure::nodes nd;
+  nd.add({0.3, 0, 0}, {0, 0, -5});  // with the box's translation: 0.6 m/s relative (the turn at r = 0.3 m)
+  nd.add({0, 0, 0}, {0, 3, -5});    // 3 m/s across the box axis: the fastest of the canopy
+  nd.add({0, 0, 1}, {0, 40, -5});   // 40 m/s relative, not a canopy node (canopy_nodes = 2): ignored
+  const double window = 2e-3;       // 3 m/s over 2 ms: 6 mm, 0.12 cells
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 8, window) == doctest::Approx(1.0 + 2.0 * 3.0 * window / h));
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 8, 0.0) == 8.0);     // no window: the travel limit
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 1, window) == 1.0);  // one finest step: a cell
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 4, 0.1) == 4.0);     // a long window: capped at the limit
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 100, window) == doctest::Approx(1.0 + 2.0 * 40.0 * window / h));
 }
 
 TEST_CASE("drop box and canopy: sizes that would overflow a count or the memory are refused first") {

@@ -295,8 +295,8 @@ struct drop_result {
   std::string fabric;
   std::vector<io::drop_history_row> history;
   io::drop_summary summary;
-  long cells = 0, nodes = 0, triangles = 0, steps = 0;
-  double substeps_per_step = 0, wall = 0;
+  long cells = 0, nodes = 0, triangles = 0, steps = 0;  ///< steps: of the coarsest level when subcycled
+  double substeps_per_step = 0, wall = 0;               ///< structure substeps per such step
   /// Block mesh: leaf cells averaged over the steps, the most at any step, and the regrids
   /// that changed the mesh (the tensor box: its cell count, the same, 0).
   double mean_cells = 0;
@@ -500,12 +500,12 @@ class drop_run {
     res.max_cells = std::max(res.cells, max_cells_);
     res.regrids = regrids_;
     if (mesh_csv_) mesh_csv_->close();
-    if (!c_.quiet)
+    if (!c_.quiet)  // subcycled, a step is one of the coarsest level, holding 2^levels of the finest
       std::fprintf(stderr,
-                   "parachute_drop: %ld fluid steps, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
+                   "parachute_drop: %ld fluid steps%s, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
                    "exchange %.1f, structure %.1f, fluid %.1f)\n",
-                   res.steps, res.substeps_per_step, res.wall, res.times.move_frame, res.times.exchange,
-                   res.times.structure, res.times.fluid);
+                   res.steps, c_.subcycle ? " of the coarsest level" : "", res.substeps_per_step, res.wall,
+                   res.times.move_frame, res.times.exchange, res.times.structure, res.times.fluid);
     if (!c_.quiet && block_mesh)
       std::fprintf(stderr,
                    "parachute_drop: block mesh: %.0f leaf cells on average over the steps, %ld at most, %ld regrids "
@@ -727,11 +727,18 @@ class drop_run {
   void regrid() {
     if constexpr (block_mesh) {
       auto& f = s_.fluid();
-      // Subcycled, a step of the coarsest level holds up to 2^levels steps of the finest,
-      // each of which the coupling's travel limit allows: the buffer counts those.
+      // Subcycled, a step of the coarsest level holds 2^levels steps of the finest, each of
+      // which the coupling's travel limit allows a cell: the buffer counts those, or, when a
+      // regrid comes every step, twice the canopy's travel at its present speed over the
+      // coming step (its length from the present mesh, and the step is held to it) plus a cell.
       const int finest_steps = c_.refine_every * (c_.subcycle ? 1 << levels_ : 1);
-      const auto canopy = drop_block_target(f, s_.structure().node_set(), su_.scene.canopy_nodes, su_.scene.triangles,
-                                            levels_, finest_steps);
+      const auto& nd = s_.structure().node_set();
+      double window = 0;
+      step_cap_ = std::numeric_limits<double>::infinity();
+      if (finest_steps > 1 && c_.refine_every == 1) window = stable_step();
+      const double travel = drop_canopy_travel(f, nd, su_.scene.canopy_nodes, levels_, finest_steps, window);
+      if (travel < double(finest_steps)) step_cap_ = window;
+      const auto canopy = drop_block_target(f, nd, su_.scene.canopy_nodes, su_.scene.triangles, levels_, travel);
       const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column || c_.static_mesh ? levels_ : 0);
       const auto near = fluid::blocks::max_of{canopy, column};
       bool changed = false;
@@ -791,14 +798,18 @@ class drop_run {
 
   /// The stable step, refused when it collapses, shortened to land on `target`.
   double next_step(double target) {
-    double dt = 0;
-    if constexpr (can_subcycle) dt = c_.subcycle ? s_.stable_dt_subcycled(c_.cfl) : s_.stable_dt(c_.cfl);
-    else dt = s_.stable_dt(c_.cfl);
+    const double dt = std::min(stable_step(), step_cap_);
     if (!(dt > 1e-9 * c_.history_every) || !std::isfinite(dt))
       throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt, " s at t = ",
                                                       s_.time(), " s (coupling ", c_.coupling, "); stopping"),
                               -1, s_.time());
     return landing_step(dt, target - s_.time());
+  }
+
+  /// The stable step on the present mesh (of the coarsest level when subcycled).
+  double stable_step() {
+    if constexpr (can_subcycle) return c_.subcycle ? s_.stable_dt_subcycled(c_.cfl) : s_.stable_dt(c_.cfl);
+    else return s_.stable_dt(c_.cfl);
   }
 
   /// Fixed box: stop with a message before the payload leaves the refined column.
@@ -819,6 +830,8 @@ class drop_run {
   std::optional<io::csv_writer> mesh_csv_;    ///< block mesh: mesh.csv
   std::vector<Eigen::Vector3d> wall_points_;  ///< mixing length: the structure's nodes in box coordinates
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
+  /// Block mesh: the longest step the last regrid's canopy buffer allows (drop_canopy_travel).
+  double step_cap_ = std::numeric_limits<double>::infinity();
   long static_rebalance_at_ = 0;  ///< --static-mesh: the step of its one cut by measured cost
   double cell_steps_ = 0;         ///< Σ over steps of the leaf cells
   const drop_config& c_;

@@ -5,6 +5,7 @@
 ///   make_drop_grid(box)               the rectilinear grid of a model::drop_box
 ///   make_drop_blocks(box, n, across)  its block-mesh layout and finest level (--mesh blocks)
 ///   drop_block_target(...)            the block mesh's refinement target: the canopy
+///   drop_canopy_travel(...)           how far the canopy may move until the next regrid
 ///   place_drop_box(fluid, box, chute) the box pose: axes, payload mass centre, velocity
 ///   drop_frame_target<Fluid>(g)       the stepper's frame target: the payload's mass centre
 ///   landing_step(dt, left)            a step shortened to land on an output instant
@@ -69,16 +70,14 @@ inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_bo
 /// The block mesh's refinement target for a drop: the finest level `level` within a buffer of
 /// the canopy's nodes (box coordinates of fluid `f`'s pose), graded outwards (each coarser
 /// level twice as far). The buffer is the canopy's longest element edge now plus
-/// (refine_every + 2) finest cells: a node moves at most one cell per step of the finest
-/// level relative to the box (the coupling's travel limit), so until the next regrid every
-/// cell the canopy cuts, with its interpolation stencil, stays on the finest level
-/// (`refine_every`: the finest level's steps between regrids, 2^levels per step when the
-/// levels are subcycled).
+/// (travel + 2) finest cells: `travel` is how many finest cells a node may move relative to
+/// the box until the next regrid (drop_canopy_travel), and the two more keep every cell the
+/// canopy cuts, with its interpolation stencil, on the finest level until then.
 template <class Fluid>
 fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f, const structure::nodes& nd,
                                                                   index_t canopy_nodes,
                                                                   const std::vector<std::array<index_t, 3>>& tris,
-                                                                  int level, int refine_every) {
+                                                                  int level, double travel) {
   const auto& lay = f.layout();
   const Eigen::Matrix3d Rt = f.pose().R.transpose();
   std::vector<Eigen::Vector3d> pts;
@@ -89,7 +88,30 @@ fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f
     for (int a = 0; a < 3; ++a)
       edge = std::max(edge, (nd.position(t[std::size_t(a)]) - nd.position(t[std::size_t((a + 1) % 3)])).norm());
   const double h = std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
-  return {lay, std::move(pts), edge + double(refine_every + 2) * h, level, true};
+  return {lay, std::move(pts), edge + (travel + 2.0) * h, level, true};
+}
+
+/// The finest cells (of width h) a canopy node may move relative to the box of fluid `f`
+/// until the next regrid, `finest_steps` steps of the finest level lasting `window` seconds
+/// in all:
+///   travel = min(K, 1 + 2 v_max window / h),
+/// K = finest_steps the coupling's travel limit (a node moves at most a cell per finest step,
+/// checked before each), v_max the largest speed of a canopy node relative to the grid now.
+/// The speed term, twice the distance at today's speed plus a cell, is the bound when many
+/// finest steps pass between regrids (a subcycled step of the coarsest level holds 2^L);
+/// a node that still leaves the finest level stops the step with a message naming its face
+/// (fluid::block_solver). window ≤ 0: the travel limit alone.
+template <class Fluid>
+double drop_canopy_travel(const Fluid& f, const structure::nodes& nd, index_t canopy_nodes, int level, int finest_steps,
+                          double window) {
+  const double K = double(finest_steps);
+  if (!(window > 0) || finest_steps <= 1) return K;
+  const auto& lay = f.layout();
+  const double h = std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
+  double v = 0;
+  for (index_t i = 0; i < canopy_nodes; ++i)
+    v = std::max(v, (nd.velocity(i) - f.pose().grid_velocity(f.pose().to_box(nd.position(i)))).norm());
+  return std::min(K, 1.0 + 2.0 * v * window / h);
 }
 
 /// The tensor box's refined block as a block-mesh criterion (--refine-column): `level` on

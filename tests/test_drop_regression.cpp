@@ -160,37 +160,46 @@ TEST_CASE("drop on blocks with level subcycling: fewer, longer steps; a restart 
   namespace fs = std::filesystem;
   parafsi::parallel::set_threads(1);
   const fs::path base = fs::temp_directory_path() / "parafsi_drop_restart_subcycle";
-  fs::remove_all(base);
-  fs::create_directories(base / "a");
-  fs::create_directories(base / "b");
-  fs::create_directories(base / "c");
   parafsi::scene::drop_config c;
-  c.resolution = "tiny";
-  c.mesh = "blocks";
-  c.block_size = 4;  // two levels at the tiny resolution
-  c.refine_every = 5;
-  c.t_end = 0.04;
-  c.initial_speed = 8.0;
-  c.quiet = true;
-  c.out = (base / "c").string();
-  const auto one_rate = parafsi::scene::run_drop(c);
-  c.subcycle = true;
-  c.out = (base / "a").string();
-  c.checkpoint_every = 0.025;
-  const auto full = parafsi::scene::run_drop(c);
-  MESSAGE("tiny drop on blocks, 0.04 s: ", one_rate.steps, " steps, subcycled ", full.steps,
-          " coarse steps; speed at 0.04 s ", one_rate.history.back().speed, " and ", full.history.back().speed, " m/s");
-  CHECK(full.steps < one_rate.steps);
-  CHECK(full.history.back().speed == doctest::Approx(one_rate.history.back().speed).epsilon(1e-3));
+  // Regrids every 5 steps (the canopy's buffer counts the finest steps) and every step
+  // (the buffer from the canopy's speed, the step held to the one it was made for).
+  for (const int every : {5, 1}) {
+    fs::remove_all(base);
+    fs::create_directories(base / "a");
+    fs::create_directories(base / "b");
+    fs::create_directories(base / "c");
+    c = {};
+    c.resolution = "tiny";
+    c.mesh = "blocks";
+    c.block_size = 4;  // two levels at the tiny resolution
+    c.refine_every = every;
+    c.t_end = 0.04;
+    c.initial_speed = 8.0;
+    c.quiet = true;
+    c.out = (base / "c").string();
+    const auto one_rate = parafsi::scene::run_drop(c);
+    c.subcycle = true;
+    c.out = (base / "a").string();
+    c.checkpoint_every = 0.025;
+    const auto full = parafsi::scene::run_drop(c);
+    MESSAGE("tiny drop on blocks, regrid every ", every, " steps, 0.04 s: ", one_rate.steps, " steps, subcycled ",
+            full.steps, " coarse steps; speed at 0.04 s ", one_rate.history.back().speed, " and ",
+            full.history.back().speed, " m/s; the canopy used at most ", full.canopy_travel_ratio,
+            " of its buffer's travel");
+    CHECK(full.steps < one_rate.steps);
+    CHECK(full.history.back().speed == doctest::Approx(one_rate.history.back().speed).epsilon(1e-3));
+    CHECK(full.canopy_travel_ratio > 0.0);
+    CHECK(full.canopy_travel_ratio < 1.0);
 
-  fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
-  c.out = (base / "b").string();
-  c.checkpoint_every = 0;
-  c.restart = (base / "b" / "checkpoint.ckpt").string();
-  const auto cont = parafsi::scene::run_drop(c);
-  REQUIRE(cont.history.size() == full.history.size());
-  CHECK(differing_values(full.history, cont.history) == 0);
-  CHECK(cont.steps == full.steps);
+    fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
+    c.out = (base / "b").string();
+    c.checkpoint_every = 0;
+    c.restart = (base / "b" / "checkpoint.ckpt").string();
+    const auto cont = parafsi::scene::run_drop(c);
+    REQUIRE(cont.history.size() == full.history.size());
+    CHECK(differing_values(full.history, cont.history) == 0);
+    CHECK(cont.steps == full.steps);
+  }
   // Subcycling needs the embedded coupling (its faces and the structure advance with the
   // finest level) and the block mesh.
   parafsi::scene::drop_config bad = c;

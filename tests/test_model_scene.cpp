@@ -472,13 +472,15 @@ TEST_CASE("drop canopy travel: the travel limit's cells, or twice the fastest no
   pf::structure::nodes nd;
   nd.add({0.3, 0, 0}, {0, 0, -5});  // with the box's translation: 0.6 m/s relative (the turn at r = 0.3 m)
   nd.add({0, 0, 0}, {0, 3, -5});    // 3 m/s across the box axis: the fastest of the canopy
-  nd.add({0, 0, 1}, {0, 40, -5});   // 40 m/s relative, not a canopy node (canopy_nodes = 2): ignored
+  nd.add({2, 0, 0}, {0, 4, -5});    // turning with the box: at rest relative to it (4 m/s if the turn were
+                                    // left out, 8 if it were taken the wrong way round)
+  nd.add({0, 0, 1}, {0, 40, -5});   // 40 m/s relative, not a canopy node (canopy_nodes = 3): ignored
   const double window = 2e-3;       // 3 m/s over 2 ms: 6 mm, 0.12 cells
-  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 8, window) == doctest::Approx(1.0 + 2.0 * 3.0 * window / h));
-  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 8, 0.0) == 8.0);     // no window: the travel limit
-  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 1, window) == 1.0);  // one finest step: a cell
-  CHECK(pf::scene::drop_canopy_travel(f, nd, 2, 2, 4, 0.1) == 4.0);     // a long window: capped at the limit
-  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 100, window) == doctest::Approx(1.0 + 2.0 * 40.0 * window / h));
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 8, window) == doctest::Approx(1.0 + 2.0 * 3.0 * window / h));
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 8, 0.0) == 8.0);     // no window: the travel limit
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 1, window) == 1.0);  // one finest step: a cell
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 3, 2, 4, 0.1) == 4.0);     // a long window: capped at the limit
+  CHECK(pf::scene::drop_canopy_travel(f, nd, 4, 2, 100, window) == doctest::Approx(1.0 + 2.0 * 40.0 * window / h));
 }
 
 TEST_CASE("drop box and canopy: sizes that would overflow a count or the memory are refused first") {

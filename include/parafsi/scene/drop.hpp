@@ -33,7 +33,9 @@
 /// auto or one_sided: coupling::embedded<P, true>, second order up to the membrane), or
 /// takes their own values (first_order).
 ///
-/// Loop (each step): the stable step at `cfl`, shortened to land on the next output
+/// Loop (each step): on the block mesh the regrid to the canopy (every `refine_every`
+/// steps); the stable step at `cfl` (subcycled, no longer than the step the regrid's canopy
+/// buffer was made for: drop_canopy_travel), shortened to land on the next output
 /// instant n · history_every (an integer n, so a restarted run takes the steps of the
 /// uninterrupted one); the coupled step (the stepper moves the box after the payload:
 /// its frame target, `drop_frame_target`). At each output
@@ -301,6 +303,10 @@ struct drop_result {
   /// that changed the mesh (the tensor box: its cell count, the same, 0).
   double mean_cells = 0;
   long max_cells = 0, regrids = 0;
+  /// Block mesh: the canopy's largest displacement relative to the box between two regrids
+  /// as a fraction of the travel the earlier regrid's buffer allowed (since the start or the
+  /// restart; above 1 the canopy left its buffer; 0 on the tensor box and a static mesh).
+  double canopy_travel_ratio = 0;
   stepper_phase_times times{};
 };
 
@@ -499,6 +505,7 @@ class drop_run {
     res.mean_cells = counted_steps_ ? cell_steps_ / double(counted_steps_) : double(res.cells);
     res.max_cells = std::max(res.cells, max_cells_);
     res.regrids = regrids_;
+    res.canopy_travel_ratio = travel_ratio_;
     if (mesh_csv_) mesh_csv_->close();
     if (!c_.quiet)  // subcycled, a step is one of the coarsest level, holding 2^levels of the finest
       std::fprintf(stderr,
@@ -509,8 +516,9 @@ class drop_run {
     if (!c_.quiet && block_mesh)
       std::fprintf(stderr,
                    "parachute_drop: block mesh: %.0f leaf cells on average over the steps, %ld at most, %ld regrids "
-                   "changed it (mesh.csv)\n",
-                   res.mean_cells, res.max_cells, res.regrids);
+                   "changed it (mesh.csv); the canopy moved at most %.2f of the travel its buffer allowed between "
+                   "regrids\n",
+                   res.mean_cells, res.max_cells, res.regrids, res.canopy_travel_ratio);
     io::summary_options so;
     so.force_cutoff = c_.force_cutoff;
     so.sample_interval = c_.history_every;
@@ -735,9 +743,10 @@ class drop_run {
       const auto& nd = s_.structure().node_set();
       double window = 0;
       step_cap_ = std::numeric_limits<double>::infinity();
-      if (finest_steps > 1 && c_.refine_every == 1) window = stable_step();
+      if (finest_steps > 1 && c_.refine_every == 1 && !c_.static_mesh) window = stable_step();
       const double travel = drop_canopy_travel(f, nd, su_.scene.canopy_nodes, levels_, finest_steps, window);
       if (travel < double(finest_steps)) step_cap_ = window;
+      note_canopy_travel(travel);
       const auto canopy = drop_block_target(f, nd, su_.scene.canopy_nodes, su_.scene.triangles, levels_, travel);
       const auto column = drop_column_target(f.layout(), su_.box, c_.refine_column || c_.static_mesh ? levels_ : 0);
       const auto near = fluid::blocks::max_of{canopy, column};
@@ -764,6 +773,26 @@ class drop_run {
       mesh_csv_->row(row);
       ++mesh_rows_;
     }
+  }
+
+  /// The canopy's largest displacement relative to the box since the last regrid, as a
+  /// fraction of the travel that regrid's buffer allowed (kept as the run's maximum,
+  /// drop_result::canopy_travel_ratio); then this regrid's positions and travel.
+  void note_canopy_travel(double travel) {
+    const auto& f = s_.fluid();
+    const auto& nd = s_.structure().node_set();
+    const std::size_t n = std::size_t(su_.scene.canopy_nodes);
+    if (travel_from_.size() == n && travel_allowed_ > 0) {
+      double moved = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        moved = std::max(moved, (f.pose().to_box(nd.position(index_t(i))) - travel_from_[i]).norm());
+      travel_ratio_ = std::max(travel_ratio_, moved / travel_allowed_);
+    }
+    travel_from_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) travel_from_[i] = f.pose().to_box(nd.position(index_t(i)));
+    const auto& lay = f.layout();
+    travel_allowed_ = travel *
+                      std::min({lay.cell_width(0, levels_), lay.cell_width(1, levels_), lay.cell_width(2, levels_)});
   }
 
   /// Mixing length: d_w from the structure's nodes (canopy and lines, box coordinates of
@@ -798,7 +827,9 @@ class drop_run {
 
   /// The stable step, refused when it collapses, shortened to land on `target`.
   double next_step(double target) {
-    const double dt = std::min(stable_step(), step_cap_);
+    // Held to the step the last regrid's canopy buffer was made for (once: the cap is
+    // the coming step's only).
+    const double dt = std::min(stable_step(), std::exchange(step_cap_, std::numeric_limits<double>::infinity()));
     if (!(dt > 1e-9 * c_.history_every) || !std::isfinite(dt))
       throw numerical_failure(parafsi::detail::concat("parachute_drop: the stable step collapsed to ", dt, " s at t = ",
                                                       s_.time(), " s (coupling ", c_.coupling, "); stopping"),
@@ -832,6 +863,10 @@ class drop_run {
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
   /// Block mesh: the longest step the last regrid's canopy buffer allows (drop_canopy_travel).
   double step_cap_ = std::numeric_limits<double>::infinity();
+  /// Block mesh: the canopy's box positions at the last regrid, the distance its buffer
+  /// allowed them to travel, and the largest fraction of it used (note_canopy_travel).
+  std::vector<Eigen::Vector3d> travel_from_;
+  double travel_allowed_ = 0, travel_ratio_ = 0;
   long static_rebalance_at_ = 0;  ///< --static-mesh: the step of its one cut by measured cost
   double cell_steps_ = 0;         ///< Σ over steps of the leaf cells
   const drop_config& c_;

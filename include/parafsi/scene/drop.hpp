@@ -790,9 +790,7 @@ class drop_run {
     }
     travel_from_.resize(n);
     for (std::size_t i = 0; i < n; ++i) travel_from_[i] = f.pose().to_box(nd.position(index_t(i)));
-    const auto& lay = f.layout();
-    travel_allowed_ = travel *
-                      std::min({lay.cell_width(0, levels_), lay.cell_width(1, levels_), lay.cell_width(2, levels_)});
+    travel_allowed_ = travel * drop_cell_width(f.layout(), levels_);
   }
 
   /// Mixing length: d_w from the structure's nodes (canopy and lines, box coordinates of

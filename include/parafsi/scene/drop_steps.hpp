@@ -67,6 +67,13 @@ inline std::pair<fluid::block_layout, int> make_drop_blocks(const model::drop_bo
   return {lay, L};
 }
 
+/// The narrowest cell width of level `level` of a block layout (the canopy's buffer and travel
+/// are counted in these).
+template <class Layout>
+double drop_cell_width(const Layout& lay, int level) {
+  return std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
+}
+
 /// The block mesh's refinement target for a drop: the finest level `level` within a buffer of
 /// the canopy's nodes (box coordinates of fluid `f`'s pose), graded outwards (each coarser
 /// level twice as far). The buffer is the canopy's longest element edge now plus
@@ -87,7 +94,7 @@ fluid::blocks::near_points<fluid::block_layout> drop_block_target(const Fluid& f
   for (const auto& t : tris)
     for (int a = 0; a < 3; ++a)
       edge = std::max(edge, (nd.position(t[std::size_t(a)]) - nd.position(t[std::size_t((a + 1) % 3)])).norm());
-  const double h = std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
+  const double h = drop_cell_width(lay, level);
   return {lay, std::move(pts), edge + (travel + 2.0) * h, level, true};
 }
 
@@ -107,7 +114,7 @@ double drop_canopy_travel(const Fluid& f, const structure::nodes& nd, index_t ca
   const double K = double(finest_steps);
   if (!(window > 0) || finest_steps <= 1) return K;
   const auto& lay = f.layout();
-  const double h = std::min({lay.cell_width(0, level), lay.cell_width(1, level), lay.cell_width(2, level)});
+  const double h = drop_cell_width(lay, level);
   double v = 0;
   for (index_t i = 0; i < canopy_nodes; ++i)
     v = std::max(v, (nd.velocity(i) - f.pose().grid_velocity(f.pose().to_box(nd.position(i)))).norm());

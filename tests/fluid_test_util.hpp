@@ -70,4 +70,23 @@ inline parafsi::fluid::blocks::tree refined_tree(std::array<pf::index_t, 3> nb, 
   return t;
 }
 
+/// Level 2 on the blocks within 1 of a vortex moving with (u_inf, v_inf) from (cx, cy) on
+/// the periodic 10 × 10 layout `lay`, level 1 within 2.5, at the solver's time.
+template <class S>
+auto moving_vortex_target(const S& s, const pf::fluid::block_layout& lay,
+                          const pf::fluid::reference::isentropic_vortex& v) {
+  return [&s, &lay, v](const pf::fluid::blocks::location& q) {
+    const double t = s.time();
+    const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
+    double d2 = 0;
+    for (int d = 0; d < 2; ++d) {
+      const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
+      double e = std::clamp(c[d], a, a + w) - c[d];
+      e -= 10.0 * std::round(e / 10.0);
+      d2 += e * e;
+    }
+    return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
+  };
+}
+
 }  // namespace pft

@@ -161,20 +161,6 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
     CHECK(kinds[2] > 0);
   }
   // The refined region follows the vortex: level 2 within 1 of its centre, level 1 within 2.5.
-  auto target_of = [&](const auto& s) {
-    return [&](const fb::location& q) {
-      const double t = s.time();
-      const Eigen::Vector3d c(std::fmod(v.cx + v.u_inf * t, 10.0), std::fmod(v.cy + v.v_inf * t, 10.0), 1.25);
-      double d2 = 0;
-      for (int d = 0; d < 2; ++d) {
-        const double w = lay.block_width(d, q.level), a = w * double(q.l[std::size_t(d)]);
-        double e = std::clamp(c[d], a, a + w) - c[d];
-        e -= 10.0 * std::round(e / 10.0);
-        d2 += e * e;
-      }
-      return d2 < 1.0 ? 2 : (d2 < 6.25 ? 1 : 0);
-    };
-  };
   int regrids = 0, dt_differ = 0, indicator_differ = 0;
   const auto before = halo->counters();
   // The one-process run on one thread, the distributed one on two threads per process (the
@@ -192,8 +178,8 @@ TEST_CASE("distributed block mesh: a vortex through three levels and moving regr
     if (n % 4 == 3) {
       // The vorticity criterion's values: each process its blocks', gathered.
       indicator_differ += serial->vorticity_indicator() != dist->vorticity_indicator();
-      const bool a = serial->regrid(target_of(*serial), 2);
-      const bool b = dist->regrid(target_of(*dist), 2);
+      const bool a = serial->regrid(pft::moving_vortex_target(*serial, lay, v), 2);
+      const bool b = dist->regrid(pft::moving_vortex_target(*dist, lay, v), 2);
       CHECK(a == b);
       regrids += a;
       if (b) list_bad += list_mismatches(*dist, *halo);

@@ -1371,14 +1371,9 @@ class block_solver {
       // The coarser level at the stage's time, for the prolonged ghosts.
       double theta = li > 0 ? (tau - Tp) / dtp : 1.0;
       if (std::fabs(theta - 1.0) < 1e-12) theta = 1.0;
-      if (theta != 1.0) interpolate_coarser(li, theta);
-      detail::timed(times_.fluxes, [&] {
-        for_ids(ids, [&](index_t id) {
-          fill_block_ghosts(id, tau, geo);
-          sweep_block(id, geo);
-        });
-      });
-      if (theta != 1.0) restore_coarser(li);
+      if (theta != 1.0) detail::timed(times_.boundaries, [&] { interpolate_coarser(li, theta); });
+      ghosts_and_sweeps(ids, tau, geo);
+      if (theta != 1.0) detail::timed(times_.boundaries, [&] { restore_coarser(li); });
       // This stage's fluxes at the coarse–fine faces into the accumulators: this level's
       // own as the coarse side, and as the fine side of the coarser level's faces.
       for_ids(ids, [&](index_t id) { accumulate_coarse(id, beta[std::size_t(s)]); });
@@ -1500,34 +1495,8 @@ class block_solver {
     using detail::timed;
     const auto geo = detail::geometry(pose_);
     ensure_buffers();
-    // Each block of `ids` gets its ghosts and then, while they are in cache, its sweeps (the
-    // ghosts read other blocks' interior state, which no sweep writes, so the fused order
-    // changes no bit). The loop's wall time is split between `boundaries` and `fluxes` in
-    // the ratio of the seconds the threads spent on each (summed per thread, in thread
-    // order). Then the coarse–fine corrections.
-    ghost_seconds_.assign(bufs_.size(), 0.0);
-    work_seconds_.assign(bufs_.size(), 0.0);
-    auto ghosts_and_sweeps = [&](const std::vector<index_t>& ids) {
-      const auto start = std::chrono::steady_clock::now();
-      for_ids(ids, [&](index_t id) {
-        const std::size_t tid = std::size_t(parallel::thread_id());
-        costed(id, [&] {
-          timed(work_seconds_[tid], [&] {
-            timed(ghost_seconds_[tid], [&] { fill_block_ghosts(id, t, geo); });
-            sweep_block(id, geo);
-          });
-        });
-      });
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      double g = 0.0, w = 0.0;
-      for (std::size_t k = 0; k < ghost_seconds_.size(); ++k) {
-        g += std::exchange(ghost_seconds_[k], 0.0);
-        w += std::exchange(work_seconds_[k], 0.0);
-      }
-      const double share = w > 0.0 ? wall * (g / w) : 0.0;
-      times_.boundaries += share;
-      times_.fluxes += wall - share;
-    };
+    // Each block gets its ghosts and its sweeps (ghosts_and_sweeps), then the coarse–fine
+    // corrections.
     auto corrections = [&](const std::vector<index_t>& ids) {
       timed(times_.fluxes, [&] { for_ids(ids, [&](index_t id) { costed(id, [&] { correct_fluxes(id); }); }); });
     };
@@ -1538,21 +1507,51 @@ class block_solver {
       // swept and the corrections that read only local registers are made. Every block
       // gets the same operations as on one process, so the order changes no bit.
       timed(times_.exchange, [&] { halo_->begin_state(); });
-      ghosts_and_sweeps(local_ids_);
+      ghosts_and_sweeps(local_ids_, t, geo);
       timed(times_.exchange, [&] { halo_->end_state(); });
-      ghosts_and_sweeps(remote_send_ids_);
+      ghosts_and_sweeps(remote_send_ids_, t, geo);
       timed(times_.exchange, [&] { halo_->begin_registers(); });
-      ghosts_and_sweeps(remote_ids_);
+      ghosts_and_sweeps(remote_ids_, t, geo);
       corrections(correct_local_ids_);
       timed(times_.exchange, [&] { halo_->end_registers(); });
       corrections(correct_remote_ids_);
     } else {
-      ghosts_and_sweeps(local_ids_);
+      ghosts_and_sweeps(local_ids_, t, geo);
       corrections(correct_local_ids_);
     }
     if (!patcher.patch_faces().empty()) timed(times_.fluxes, [&] { patch_faces(geo, stage, patcher); });
     if (sources_on_ || bc_.layer.cells > 0)
       timed(times_.sources, [&] { for_computed([&](index_t id) { costed(id, [&] { add_sources(id); }); }); });
+  }
+
+  /// Each block of `ids` gets its ghosts at time t and then, while they are in cache, its
+  /// sweeps (the ghosts read other blocks' interior state, which no sweep writes, so the
+  /// fused order changes no bit). The loop's wall time is split between `boundaries` and
+  /// `fluxes` in the ratio of the seconds the threads spent on each (summed per thread, in
+  /// thread order).
+  void ghosts_and_sweeps(const std::vector<index_t>& ids, double t, const detail::stage_geometry& geo) {
+    using detail::timed;
+    ghost_seconds_.assign(bufs_.size(), 0.0);
+    work_seconds_.assign(bufs_.size(), 0.0);
+    const auto start = std::chrono::steady_clock::now();
+    for_ids(ids, [&](index_t id) {
+      const std::size_t tid = std::size_t(parallel::thread_id());
+      costed(id, [&] {
+        timed(work_seconds_[tid], [&] {
+          timed(ghost_seconds_[tid], [&] { fill_block_ghosts(id, t, geo); });
+          sweep_block(id, geo);
+        });
+      });
+    });
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double g = 0.0, w = 0.0;
+    for (std::size_t k = 0; k < ghost_seconds_.size(); ++k) {
+      g += ghost_seconds_[k];
+      w += work_seconds_[k];
+    }
+    const double share = w > 0.0 ? wall * (g / w) : 0.0;
+    times_.boundaries += share;
+    times_.fluxes += wall - share;
   }
 
   /// Primitives and the three flux sweeps of block id (and its viscous pass), keeping its
@@ -2377,14 +2376,14 @@ class block_solver {
   std::unique_ptr<turbulence_storage> T_;                 ///< with an eddy-viscosity closure
   std::vector<std::uint8_t> blocked_;                     ///< membrane faces' marks (one-sided patches; global_index)
   std::vector<index_t> zone_, share_block_, share_slot_;  ///< patch_zone, share_slots scratch
-  std::vector<double> ghost_seconds_, work_seconds_;      ///< compute_rhs: ghosts', ghosts' + sweeps' s per thread
-  std::vector<double> records_;                           ///< solve_faces: face_record::width per face
-  std::vector<index_t> record_block_;                     ///< solve_faces: the block of each face's high cell
-  std::vector<index_t> mine_;                             ///< solve_faces: the faces this process solves
-  std::vector<double> heads_;                             ///< send_records: face_record::head per face
-  std::vector<std::vector<double>> out_, in_;             ///< halo::exchange lists (fetch_slots, send_records)
-  std::vector<std::vector<double>> asks_, asked_;         ///< fetch_slots: the slots asked of / by each process
-  std::vector<char> to_;                                  ///< send_records: the processes a record goes to
+  std::vector<double> ghost_seconds_, work_seconds_;  ///< ghosts_and_sweeps: ghosts', ghosts' + sweeps' s per thread
+  std::vector<double> records_;                       ///< solve_faces: face_record::width per face
+  std::vector<index_t> record_block_;                 ///< solve_faces: the block of each face's high cell
+  std::vector<index_t> mine_;                         ///< solve_faces: the faces this process solves
+  std::vector<double> heads_;                         ///< send_records: face_record::head per face
+  std::vector<std::vector<double>> out_, in_;         ///< halo::exchange lists (fetch_slots, send_records)
+  std::vector<std::vector<double>> asks_, asked_;     ///< fetch_slots: the slots asked of / by each process
+  std::vector<char> to_;                              ///< send_records: the processes a record goes to
   std::vector<std::pair<std::size_t, const double*>> held_;  ///< send_records: (face, record) this process replays
   std::size_t failed_at_ = 0;                                ///< solve_faces: the first face it failed to solve
   std::exception_ptr failure_;                               ///< and that face's error

@@ -108,6 +108,11 @@ int main(int argc, char** argv) {
   app.add_option("--fabric", c.fabric, "canopy fabric of the paper's Table 2 (paper canopy)")
       ->check(CLI::IsMember({"mat544", "mat59225", "mat509"}))
       ->capture_default_str();
+  app.add_option("--permeability", c.permeability,
+                 "the fabric whose Ergun law (alpha, beta, thickness) the cloth's through-flow follows, keeping the "
+                 "canopy fabric's weight and moduli (default: the canopy fabric's own); summary.csv's fabric "
+                 "column then reads FABRIC+F_permeability")
+      ->check(CLI::IsMember({"mat544", "mat59225", "mat509", "c9_mil_c_7020"}));
   app.add_option("--resolution", c.resolution,
                  "draft (element D0/20, cell D0/10), coarse (D0/30, D0/15), medium (D0/40, D0/20), fine (D0/60, "
                  "D0/30); tiny for tests")

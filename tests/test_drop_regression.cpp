@@ -286,6 +286,7 @@ TEST_CASE("drop restart: a changed scene parameter is refused by name") {
           {"payload_mass", [](cfg& c) { c.payload_mass = 50; }},
           {"line_stiffness", [](cfg& c) { c.line_stiffness = 10; }},
           {"modulus_scale", [](cfg& c) { c.modulus_scale = 10; }},
+          {"permeability", [](cfg& c) { c.permeability = "mat509"; }},
           {"packed", [](cfg& c) { c.packed = "constructed"; }},
           {"packed_parameter", [](cfg& c) { c.packed_parameter = 0.3; }},
           {"box",
@@ -375,6 +376,39 @@ TEST_CASE("drop config: silently dropped settings are refused by name") {
   c = cfg{};
   c.static_mesh = true;
   refused(c, "--static-mesh needs --mesh blocks");
+  c = cfg{};
+  c.permeability = "silk";
+  refused(c, "--permeability: model::fabric: unknown fabric 'silk'");
+}
+
+// --permeability F: the cloth's Ergun law is fabric F's (α, β and thickness of Table 2),
+// the cloth's weight and moduli stay the canopy fabric's, and the summary's fabric column
+// says so.
+TEST_CASE("drop config: --permeability takes another fabric's Ergun law and keeps the cloth") {
+  namespace sc = parafsi::scene;
+  sc::drop_config c;
+  c.resolution = "tiny";
+  c.fabric = "mat544";
+  const sc::drop_setup own = sc::make_drop_setup(c);
+  c.permeability = "mat509";
+  const sc::drop_setup swapped = sc::make_drop_setup(c);
+  const auto& f509 = parafsi::model::fabric("mat509");
+  const auto& f544 = parafsi::model::fabric("mat544");
+  const parafsi::porosity::ergun law = sc::drop_porosity_law(c, swapped);
+  CHECK(law.alpha == f509.alpha);  // 299 337.56 kg m^-3 s^-1 against mat544's 22 498 098.80
+  CHECK(law.beta == f509.beta);
+  CHECK(law.thickness == f509.thickness);
+  c.permeability.clear();
+  const parafsi::porosity::ergun own_law = sc::drop_porosity_law(c, own);
+  CHECK(own_law.alpha == f544.alpha);
+  CHECK(own_law.thickness == f544.thickness);
+  // The cloth itself is unchanged: the same areal density and moduli.
+  CHECK(swapped.scene.fabric.name == "mat544");
+  CHECK(swapped.scene.moduli.areal_density == own.scene.moduli.areal_density);
+  CHECK(swapped.scene.moduli.E11 == own.scene.moduli.E11);
+  CHECK(sc::drop_fabric_label(c, own) == "mat544");
+  c.permeability = "mat509";
+  CHECK(sc::drop_fabric_label(c, swapped) == "mat544+mat509_permeability");
 }
 
 // Extreme scenes on the tiny grid (0.25 s), with the penalty coupling and with the

@@ -97,8 +97,11 @@ namespace parafsi::scene {
 /// Every choice of a drop run. The defaults are parachute_drop's (its flags bind to these
 /// fields); `out` empty writes no files.
 struct drop_config {
-  std::string canopy = "paper";       ///< paper | c9
-  std::string fabric = "mat544";      ///< paper canopy: mat544 | mat59225 | mat509
+  std::string canopy = "paper";   ///< paper | c9
+  std::string fabric = "mat544";  ///< paper canopy: mat544 | mat59225 | mat509
+  /// The fabric whose Ergun law (α, β, thickness) the cloth's through-flow follows; empty:
+  /// the canopy's own. Isolates permeability from the cloth's weight and moduli.
+  std::string permeability;
   std::string resolution = "coarse";  ///< draft | coarse | medium | fine | tiny (model::drop_resolution)
   std::string coupling = "embedded";  ///< embedded | penalty
   std::string mesh = "tensor";        ///< tensor: the refined rectilinear box; blocks: the block mesh
@@ -267,6 +270,13 @@ struct drop_config {
     require(stiffening == 0 || (stiffening >= 0.01 && stiffening <= 10),
             "parachute_drop: --stiffening must be 0 (off) or in [0.01, 10], got ", stiffening);
     require(line_stiffness > 0, "parachute_drop: line stiffness scale must be > 0, got ", line_stiffness);
+    if (!permeability.empty()) {
+      try {
+        model::fabric(permeability);
+      } catch (const invalid_input& e) {
+        throw invalid_input(parafsi::detail::concat("parachute_drop: --permeability: ", e.what()));
+      }
+    }
     require(modulus_scale > 0, "parachute_drop: fabric modulus scale must be > 0, got ", modulus_scale);
     require(pgs_alpha == 0 || pgs_alpha >= 1, "parachute_drop: --pgs (PGS alpha) must be >= 1 (0: auto), got ",
             pgs_alpha);
@@ -400,6 +410,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
+  if (!c.permeability.empty()) g.add("permeability", c.permeability);
   g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
   g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
   g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
@@ -414,6 +425,21 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   if (c.mesh == "blocks" && c.subcycle) g.add("subcycle", std::int64_t(1));
   if (c.mesh == "blocks" && c.root_blocks != 2) g.add("root_blocks", std::int64_t(c.root_blocks));
   return g;
+}
+
+/// The Ergun law of the drop's cloth: the canopy fabric's, or with `--permeability F` that
+/// of fabric F (its α, β and thickness: Δp = t (α V + β V²)).
+inline porosity::ergun drop_porosity_law(const drop_config& c, const drop_setup& su) {
+  const model::fabric_data& f = c.permeability.empty() ? su.scene.fabric : model::fabric(c.permeability);
+  return porosity::ergun{f.alpha, f.beta, f.thickness};
+}
+
+/// The fabric column of summary.csv: the canopy's fabric, followed by "+F_permeability"
+/// when its through-flow follows fabric F's law (so runs group by what the cloth was).
+inline std::string drop_fabric_label(const drop_config& c, const drop_setup& su) {
+  std::string label(su.scene.fabric.name);
+  if (!c.permeability.empty()) label += "+" + c.permeability + "_permeability";
+  return label;
 }
 
 namespace detail {
@@ -468,7 +494,7 @@ class drop_run {
     }
     res.nodes = long(nd.size());
     res.triangles = long(su_.scene.triangles.size());
-    res.fabric = std::string(su_.scene.fabric.name);
+    res.fabric = drop_fabric_label(c_, su_);
     if (!c_.quiet) {
       char mesh[160];
       if constexpr (block_mesh)
@@ -929,7 +955,7 @@ inline drop_result run_drop(const drop_config& c, const drop_progress& progress 
   bc.layer = {3, 0.5};
   return detail::with_fluid_policies(su, c.closure(), [&](auto visc, auto closure, auto frame) -> drop_result {
     structure::drop_assembly chute = structure::make_drop_assembly(S, c.membrane_damping);
-    const porosity::ergun law{S.fabric.alpha, S.fabric.beta, S.fabric.thickness};
+    const porosity::ergun law = drop_porosity_law(c, su);
     if (c.mesh == "blocks") {
       // The block mesh: one level to start with, refined to the canopy before the first step.
       const auto [lay, levels] = make_drop_blocks(su.box, c.block_size, c.root_blocks);

@@ -1,0 +1,192 @@
+#!/usr/bin/env python3
+"""Compare the descent of groups of drops (fabrics, meshes, closures) with run-to-run error bars.
+
+    scripts/descent_ensemble.py RUN_DIR [...] [--window 3 8] [--group-by fabric|REGEX] [--sub S]
+
+A single drop's mean speed and drag over a fixed window carry the swing it happens to make:
+the swing grows out of round-off, so its onset and size differ between runs that differ
+only at round-off (a grid offset, a thread count), by seconds and by tens of degrees
+(validation.md section 3.4). This script takes several runs of each group, e.g. the same
+fabric at --grid-offset 0, 0.25, 0.5, and gives:
+
+* per run, over --window: mean payload speed, mean drag_coefficient (2 W / (rho v^2 S0)),
+  the rms canopy tilt (degrees, from canopy_phi_x and canopy_phi_y of history.csv) and the
+  mean canopy_diameter (the skirt's; C_D on the projected area is C_D (D0 / D)^2);
+* per group: the number of runs n, the mean of each, its sample standard deviation s and
+  the standard error s / sqrt(n);
+* per pair of groups: the difference of the mean C_D with its standard error
+  sqrt(s1^2/n1 + s2^2/n2), and the ratio of the two;
+* per group, when the runs have summary.csv: the mean and sample standard deviation of the
+  opening read-outs t_f, t_mo, t_p and F_p (their run-to-run spread);
+* the drag at equal attitude: a least-squares fit C_D = c_g + k theta_rms^2 with one
+  intercept c_g per group and a slope k shared by all (the axial drag of a canopy is even
+  in its tilt), over the runs' windows or, with --sub S, over consecutive sub-windows of S
+  seconds (more points, each a phase of the swing when S is shorter than its period).
+  The intercepts are the groups' C_D without a swing; their difference says how much of a
+  group difference remains when the swing is accounted for, with the fit's standard errors.
+
+Groups: --group-by fabric (default) reads the fabric from each run's summary.csv; any other
+value is a regular expression whose first group, matched against the run's directory name,
+names the group (e.g. '(mat[0-9]+)_').
+
+The histories must reach the window's end (a shorter run is refused) and be finite over it.
+"""
+import argparse
+import itertools
+import os
+import re
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from descent_phases import load, require_finite  # noqa: E402
+
+
+def group_of(run_dir, how):
+    if how == "fabric":
+        summary = os.path.join(run_dir, "summary.csv")
+        try:
+            with open(summary) as f:
+                rows = [r.strip() for r in f if r.strip()]
+        except OSError:
+            sys.exit(f"descent_ensemble: {summary}: no summary file to read the fabric from (--group-by REGEX)")
+        if len(rows) < 2 or not rows[0].startswith("fabric,"):
+            sys.exit(f"descent_ensemble: {summary}: no fabric column")
+        return rows[1].split(",")[0]
+    m = re.search(how, os.path.basename(os.path.normpath(run_dir)))
+    if not m or not m.groups():
+        sys.exit(f"descent_ensemble: --group-by '{how}' names no group in {run_dir}")
+    return m.group(1)
+
+
+def windows(a, lo, hi, sub):
+    """(rms tilt, mean C_D, mean speed) over [lo, hi] or its consecutive sub-windows of `sub` s."""
+    t = a["t"]
+    tilt = np.hypot(a["canopy_phi_x"], a["canopy_phi_y"])
+    edges = [lo, hi] if not sub else list(np.arange(lo, hi - 1e-9, sub)) + [hi]
+    out = []
+    for w0, w1 in zip(edges[:-1], edges[1:]):
+        m = (t >= w0) & (t <= w1)
+        if m.sum() < 2:
+            continue
+        out.append((np.sqrt(np.mean(tilt[m] ** 2)), a["drag_coefficient"][m].mean(), a["speed"][m].mean()))
+    return out
+
+
+def opening(run_dir):
+    """t_f, t_mo, t_p, F_p of the run's summary.csv, or None without one."""
+    path = os.path.join(run_dir, "summary.csv")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as f:
+        rows = [r.strip().split(",") for r in f if r.strip()]
+    if len(rows) < 2:
+        return None
+    head, vals = rows[0], rows[1]
+    try:
+        return [float(vals[head.index(k)]) for k in ("t_f", "t_mo", "t_p", "F_p")]
+    except (ValueError, IndexError):
+        sys.exit(f"descent_ensemble: {path}: no t_f, t_mo, t_p, F_p columns")
+
+
+def stats(x):
+    x = np.asarray(x, float)
+    n = len(x)
+    s = x.std(ddof=1) if n > 1 else np.nan
+    return x.mean(), s, s / np.sqrt(n) if n > 1 else np.nan
+
+
+def attitude_fit(points, groups):
+    """Least squares C_D = c_g + k theta^2: intercepts, slope, their standard errors, rms residual."""
+    A = np.zeros((len(points), len(groups) + 1))
+    y = np.array([p[2] for p in points])
+    for r, (g, th, _) in enumerate(points):
+        A[r, groups.index(g)] = 1.0
+        A[r, -1] = th**2
+    dof = len(points) - A.shape[1]
+    if dof < 1 or np.linalg.matrix_rank(A) < A.shape[1]:
+        return None
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    res = y - A @ coef
+    s2 = res @ res / dof
+    cov = s2 * np.linalg.inv(A.T @ A)
+    return coef, cov, np.sqrt(s2), dof
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("runs", nargs="+", help="run directories (history.csv, and summary.csv for --group-by fabric)")
+    p.add_argument("--window", type=float, nargs=2, default=(3.0, 8.0), help="averaging window (s)")
+    p.add_argument("--group-by", default="fabric", help="'fabric' or a regex whose first group names the group")
+    p.add_argument("--sub", type=float, default=0.0, help="attitude fit over sub-windows of this many s (0: whole)")
+    o = p.parse_args()
+    lo, hi = o.window
+    if not hi > lo or o.sub < 0 or (o.sub and o.sub > hi - lo):
+        sys.exit("descent_ensemble: the window's end must follow its start, and 0 <= --sub <= its length")
+    rows, points = [], []
+    for r in o.runs:
+        path, a = load(r)
+        require_finite(path, a, lo)
+        if a["t"][-1] < hi - 1e-9:
+            sys.exit(f"descent_ensemble: {path} ends at {a['t'][-1]:.3f} s, before the window's end {hi} s")
+        run_dir = os.path.dirname(path) or "."
+        g = group_of(run_dir, o.group_by)
+        (tilt, cd, v), = windows(a, lo, hi, 0.0)
+        win = (a["t"] >= lo) & (a["t"] <= hi)
+        diameter = a["canopy_diameter"][win].mean() if "canopy_diameter" in a.dtype.names else np.nan
+        rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter))
+        points += [(g, th, c) for th, c, _ in windows(a, lo, hi, o.sub)]
+    groups = sorted({r[0] for r in rows})
+    print(f"# window [{lo}, {hi}] s; per run: mean speed (m/s), mean C_D, rms canopy tilt (deg), mean skirt "
+          "diameter (m)")
+    print("group run v cd tilt_rms diameter")
+    for g, d, v, cd, tilt, _, dia in sorted(rows, key=lambda r: r[:2]):
+        print(f"{g} {d} {v:.4f} {cd:.4f} {tilt:.2f} {dia:.4f}")
+    print("# per group: n, mean, sample standard deviation s, standard error s/sqrt(n)")
+    print("group n v_mean v_s cd_mean cd_s cd_se tilt_mean tilt_s diameter_mean diameter_s")
+    summary = {}
+    for g in groups:
+        sel = [r for r in rows if r[0] == g]
+        v, vs, _ = stats([r[2] for r in sel])
+        cd, cds, cdse = stats([r[3] for r in sel])
+        ti, tis, _ = stats([r[4] for r in sel])
+        dm, ds, _ = stats([r[6] for r in sel])
+        summary[g] = (len(sel), cd, cds)
+        print(f"{g} {len(sel)} {v:.4f} {vs:.4f} {cd:.4f} {cds:.4f} {cdse:.4f} {ti:.2f} {tis:.2f} {dm:.4f} {ds:.4f}")
+    if all(r[5] is not None for r in rows):
+        print("# opening read-outs of summary.csv per group: mean and sample standard deviation")
+        print("group n t_f t_f_s t_mo t_mo_s t_p t_p_s F_p F_p_s")
+        for g in groups:
+            op = np.array([r[5] for r in rows if r[0] == g])
+            cols = " ".join(f"{stats(op[:, k])[0]:.4f} {stats(op[:, k])[1]:.4f}" for k in range(4))
+            print(f"{g} {len(op)} {cols}")
+    if len(groups) > 1:
+        print("# C_D differences: group_b - group_a, standard error sqrt(s_a^2/n_a + s_b^2/n_b), ratio b/a")
+        print("a b diff se ratio")
+        for ga, gb in itertools.combinations(groups, 2):
+            (na, ca, sa), (nb, cb, sb) = summary[ga], summary[gb]
+            se = np.sqrt(sa**2 / na + sb**2 / nb) if na > 1 and nb > 1 else np.nan
+            print(f"{ga} {gb} {cb - ca:+.4f} {se:.4f} {cb / ca:.4f}")
+    fit = attitude_fit(points, groups)
+    what = f"sub-windows of {o.sub} s" if o.sub else "whole windows"
+    if fit is None:
+        print(f"# attitude fit C_D = c_group + k theta_rms^2 over {what}: too few points or no spread in tilt")
+        return
+    coef, cov, rms, dof = fit
+    se = np.sqrt(np.diag(cov))
+    print(f"# attitude fit C_D = c_group + k theta_rms^2 over {what}: {len(points)} points, {dof} degrees of "
+          f"freedom, rms residual {rms:.4f}; k = {coef[-1]:.3e} +- {se[-1]:.1e} per deg^2")
+    print("group c_at_zero_tilt se")
+    for i, g in enumerate(groups):
+        print(f"{g} {coef[i]:.4f} {se[i]:.4f}")
+    if len(groups) > 1:
+        print("# intercept differences at equal attitude: b - a, standard error from the fit's covariance")
+        print("a b diff se")
+        for (i, ga), (j, gb) in itertools.combinations(enumerate(groups), 2):
+            d = coef[j] - coef[i]
+            print(f"{ga} {gb} {d:+.4f} {np.sqrt(cov[i, i] + cov[j, j] - 2 * cov[i, j]):.4f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -19,6 +19,7 @@
 // (docs/coupling.md). Defaults chosen from the work-precision table, docs/validation.md §8.
 // Studies: --box fixed --fixed-fall L (a fixed box holding a fall of L m, for the
 // following-box comparison); --packed, --modulus-scale, --line-stiffness (sensitivity);
+// --permeability (another fabric's Ergun law on this cloth: the permeability isolated);
 // --payload-mass, --initial-speed (extreme scenes). A deployment's start: --packed bundle
 // (the canopy gathered at line stretch, --packed-parameter its mouth / D0) with
 // --initial-speed the speed at line stretch.

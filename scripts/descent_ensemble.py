@@ -23,13 +23,18 @@ fabric at --grid-offset 0, 0.25, 0.5, and gives:
   in its tilt), over the runs' windows or, with --sub S, over consecutive sub-windows of S
   seconds (more points, each a phase of the swing when S is shorter than its period).
   The intercepts are the groups' C_D without a swing; their difference says how much of a
-  group difference remains when the swing is accounted for, with the fit's standard errors.
+  group difference remains when the swing is accounted for, with the fit's standard errors
+  (from its residuals; with --sub they count the sub-windows of one run as independent,
+  and a group of one run gets an intercept with no run-to-run spread behind it: the table
+  gives the runs per group).
 
-Groups: --group-by fabric (default) reads the fabric from each run's summary.csv; any other
-value is a regular expression whose first group, matched against the run's directory name,
-names the group (e.g. '(mat[0-9]+)_').
+Groups: --group-by fabric (default) reads the fabric from each run's summary.csv (a run
+with --permeability F reads FABRIC+F_permeability); any other value is a regular
+expression that must match the whole of the run's directory name, its first group naming
+the group (e.g. '(.+)_o[0-9.]+' for directories named NAME_oOFFSET).
 
-The histories must reach the window's end (a shorter run is refused) and be finite over it.
+The histories must reach the window's end (a shorter run is refused) and be finite from the
+window's start on.
 """
 import argparse
 import itertools
@@ -54,7 +59,7 @@ def group_of(run_dir, how):
         if len(rows) < 2 or not rows[0].startswith("fabric,"):
             sys.exit(f"descent_ensemble: {summary}: no fabric column")
         return rows[1].split(",")[0]
-    m = re.search(how, os.path.basename(os.path.normpath(run_dir)))
+    m = re.fullmatch(how, os.path.basename(os.path.normpath(run_dir)))
     if not m or not m.groups():
         sys.exit(f"descent_ensemble: --group-by '{how}' names no group in {run_dir}")
     return m.group(1)
@@ -132,7 +137,10 @@ def main():
             sys.exit(f"descent_ensemble: {path} ends at {a['t'][-1]:.3f} s, before the window's end {hi} s")
         run_dir = os.path.dirname(path) or "."
         g = group_of(run_dir, o.group_by)
-        (tilt, cd, v), = windows(a, lo, hi, 0.0)
+        whole = windows(a, lo, hi, 0.0)
+        if not whole:
+            sys.exit(f"descent_ensemble: {path} holds fewer than two rows in the window [{lo}, {hi}] s")
+        (tilt, cd, v), = whole
         win = (a["t"] >= lo) & (a["t"] <= hi)
         diameter = a["canopy_diameter"][win].mean() if "canopy_diameter" in a.dtype.names else np.nan
         rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter))
@@ -154,7 +162,9 @@ def main():
         dm, ds, _ = stats([r[6] for r in sel])
         summary[g] = (len(sel), cd, cds)
         print(f"{g} {len(sel)} {v:.4f} {vs:.4f} {cd:.4f} {cds:.4f} {cdse:.4f} {ti:.2f} {tis:.2f} {dm:.4f} {ds:.4f}")
-    if all(r[5] is not None for r in rows):
+    if any(r[5] is None for r in rows):
+        print("# opening read-outs left out: not every run has a summary.csv with t_f, t_mo, t_p, F_p")
+    else:
         print("# opening read-outs of summary.csv per group: mean and sample standard deviation")
         print("group n t_f t_f_s t_mo t_mo_s t_p t_p_s F_p F_p_s")
         for g in groups:
@@ -177,9 +187,9 @@ def main():
     se = np.sqrt(np.diag(cov))
     print(f"# attitude fit C_D = c_group + k theta_rms^2 over {what}: {len(points)} points, {dof} degrees of "
           f"freedom, rms residual {rms:.4f}; k = {coef[-1]:.3e} +- {se[-1]:.1e} per deg^2")
-    print("group c_at_zero_tilt se")
+    print("group runs c_at_zero_tilt se")
     for i, g in enumerate(groups):
-        print(f"{g} {coef[i]:.4f} {se[i]:.4f}")
+        print(f"{g} {sum(r[0] == g for r in rows)} {coef[i]:.4f} {se[i]:.4f}")
     if len(groups) > 1:
         print("# intercept differences at equal attitude: b - a, standard error from the fit's covariance")
         print("a b diff se")

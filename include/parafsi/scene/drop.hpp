@@ -410,7 +410,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
-  if (!c.permeability.empty()) g.add("permeability", c.permeability);
+  if (!c.permeability.empty() && c.permeability != su.scene.fabric.name) g.add("permeability", c.permeability);
   g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
   g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
   g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
@@ -435,10 +435,12 @@ inline porosity::ergun drop_porosity_law(const drop_config& c, const drop_setup&
 }
 
 /// The fabric column of summary.csv: the canopy's fabric, followed by "+F_permeability"
-/// when its through-flow follows fabric F's law (so runs group by what the cloth was).
+/// when its through-flow follows another fabric F's law (so runs group by what the cloth
+/// was; F the canopy's own fabric is the default run, label and signature alike).
 inline std::string drop_fabric_label(const drop_config& c, const drop_setup& su) {
   std::string label(su.scene.fabric.name);
-  if (!c.permeability.empty()) label += "+" + c.permeability + "_permeability";
+  if (!c.permeability.empty() && c.permeability != su.scene.fabric.name)
+    label += "+" + c.permeability + "_permeability";
   return label;
 }
 

@@ -364,6 +364,12 @@ if(Python3_Interpreter_FOUND)
     COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/cli/cli_robustness.py
             --bin $<TARGET_FILE_DIR:parachute_drop> --timeout 20 --jobs 2)
   set_tests_properties(example_cli_robustness PROPERTIES TIMEOUT 900 LABELS examples)
+  # scripts/descent_ensemble.py on synthetic drops with exact answers (means, standard
+  # deviations, the difference's standard error, the attitude fit); skipped without numpy.
+  add_test(NAME script_descent_ensemble
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/cli/test_descent_ensemble.py
+            ${PROJECT_SOURCE_DIR}/scripts/descent_ensemble.py)
+  set_tests_properties(script_descent_ensemble PROPERTIES TIMEOUT 120 LABELS examples SKIP_RETURN_CODE 77)
 endif()
 
 # ---- The drop over MPI processes (docs/guide_mpi.md): the tiny block-mesh drop for 0.05 s

@@ -391,6 +391,12 @@ inline drop_setup make_drop_setup(const drop_config& c) {
   return su;
 }
 
+/// True when `--permeability` names a fabric other than the canopy's: the cloth then follows
+/// another fabric's Ergun law (naming its own fabric is the default run).
+inline bool drop_permeability_swapped(const drop_config& c, const drop_setup& su) {
+  return !c.permeability.empty() && c.permeability != su.scene.fabric.name;
+}
+
 /// Every parameter of `c` (resolved by `su`) that changes the run: saved with each
 /// checkpoint and compared on restart (io::scene_signature), so a restart with another
 /// scene, resolution, coupling, α, payload, moduli, packed shape, box, closure, CFL,
@@ -410,7 +416,7 @@ inline io::scene_signature drop_signature(const drop_config& c, const drop_setup
   g.add("membrane_damping", c.membrane_damping).add("history_every", c.history_every);
   g.add("initial_speed", su.params.initial_speed).add("payload_mass", su.params.payload.mass);
   g.add("line_stiffness", c.line_stiffness).add("modulus_scale", c.modulus_scale);
-  if (!c.permeability.empty() && c.permeability != su.scene.fabric.name) g.add("permeability", c.permeability);
+  if (drop_permeability_swapped(c, su)) g.add("permeability", c.permeability);
   g.add("packed", c.packed).add("packed_parameter", c.packed_parameter);
   g.add("box", c.box).add("box_width", c.box_width).add("box_length", c.box_length).add("box_ahead", c.box_ahead);
   g.add("fixed_fall", su.fixed_box ? c.fixed_fall : 0.0);
@@ -439,8 +445,7 @@ inline porosity::ergun drop_porosity_law(const drop_config& c, const drop_setup&
 /// was; F the canopy's own fabric is the default run, label and signature alike).
 inline std::string drop_fabric_label(const drop_config& c, const drop_setup& su) {
   std::string label(su.scene.fabric.name);
-  if (!c.permeability.empty() && c.permeability != su.scene.fabric.name)
-    label += "+" + c.permeability + "_permeability";
+  if (drop_permeability_swapped(c, su)) label += "+" + c.permeability + "_permeability";
   return label;
 }
 

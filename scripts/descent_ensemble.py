@@ -18,6 +18,12 @@ fabric at --grid-offset 0, 0.25, 0.5, and gives:
   sqrt(s1^2/n1 + s2^2/n2), and the ratio of the two;
 * per group, when the runs have summary.csv: the mean and sample standard deviation of the
   opening read-outs t_f, t_mo, t_p and F_p (their run-to-run spread);
+* per run and per group, when every run has cloth_pressure.csv (the embedded coupling's): the
+  window's means of windward_cp and leeward_cp (the cloth's wall pressures, windward and
+  leeward, on q of the payload's speed), pressure_drag_coefficient (their difference on the
+  projected area, over S0) and through_fraction (the fabric law's through-flow over |V| S),
+  with the groups' means and sample standard deviations and the pairwise differences of the
+  two sides: which side of the cloth a group difference in C_D comes from;
 * the drag at equal attitude: a least-squares fit C_D = c_g + k theta_rms^2 with one
   intercept c_g per group and a slope k shared by all (the axial drag of a canopy is even
   in its tilt), over the runs' windows or, with --sub S, over consecutive sub-windows of S
@@ -95,6 +101,27 @@ def opening(run_dir):
         sys.exit(f"descent_ensemble: {path}: no t_f, t_mo, t_p, F_p columns")
 
 
+CLOTH = ("windward_cp", "leeward_cp", "pressure_drag_coefficient", "through_fraction")
+
+
+def cloth_means(run_dir, lo, hi):
+    """The window's means of the CLOTH columns of cloth_pressure.csv, or None without the file."""
+    path = os.path.join(run_dir, "cloth_pressure.csv")
+    if not os.path.isfile(path):
+        return None
+    a = np.genfromtxt(path, delimiter=",", names=True)
+    missing = [c for c in ("t",) + CLOTH if c not in (a.dtype.names or ())]
+    if missing:
+        sys.exit(f"descent_ensemble: {path}: no column {', '.join(missing)}")
+    m = (a["t"] >= lo) & (a["t"] <= hi)
+    if m.sum() < 2:
+        sys.exit(f"descent_ensemble: {path} holds fewer than two rows in the window [{lo}, {hi}] s")
+    vals = [a[c][m] for c in CLOTH]
+    if not all(np.isfinite(v).all() for v in vals):
+        sys.exit(f"descent_ensemble: {path}: a value in the window [{lo}, {hi}] s is not finite")
+    return [v.mean() for v in vals]
+
+
 def stats(x):
     x = np.asarray(x, float)
     n = len(x)
@@ -117,6 +144,36 @@ def attitude_fit(points, groups):
     s2 = res @ res / dof
     cov = s2 * np.linalg.inv(A.T @ A)
     return coef, cov, np.sqrt(s2), dof
+
+
+def cloth(rows, groups):
+    """The cloth's two sides (cloth_pressure.csv) per run and per group, and the groups' differences."""
+    if any(r[7] is None for r in rows):
+        print("# the cloth's two sides left out: not every run has a cloth_pressure.csv (embedded coupling)")
+        return
+    print("# the cloth's two sides (cloth_pressure.csv), window means per run")
+    print("group run " + " ".join(CLOTH))
+    for r in sorted(rows, key=lambda r: r[:2]):
+        print(f"{r[0]} {r[1]} " + " ".join(f"{x:.5f}" for x in r[7]))
+    print("# per group: n, mean and sample standard deviation of each")
+    print("group n " + " ".join(f"{c} {c}_s" for c in CLOTH))
+    means = {}
+    for g in groups:
+        sel = np.array([r[7] for r in rows if r[0] == g])
+        st = [stats(sel[:, k]) for k in range(len(CLOTH))]
+        means[g] = (len(sel), st)
+        print(f"{g} {len(sel)} " + " ".join(f"{m:.5f} {s:.5f}" for m, s, _ in st))
+    if len(groups) > 1:
+        print("# the two sides' differences: group_b - group_a, standard error sqrt(s_a^2/n_a + s_b^2/n_b)")
+        print("a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se")
+        for ga, gb in itertools.combinations(groups, 2):
+            (na, sa), (nb, sb) = means[ga], means[gb]
+            out = []
+            for k in range(3):
+                d = sb[k][0] - sa[k][0]
+                se = np.sqrt(sa[k][1] ** 2 / na + sb[k][1] ** 2 / nb) if na > 1 and nb > 1 else np.nan
+                out.append(f"{d:+.5f} {se:.5f}")
+            print(f"{ga} {gb} " + " ".join(out))
 
 
 def main():
@@ -143,13 +200,13 @@ def main():
         (tilt, cd, v), = whole
         win = (a["t"] >= lo) & (a["t"] <= hi)
         diameter = a["canopy_diameter"][win].mean() if "canopy_diameter" in a.dtype.names else np.nan
-        rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter))
+        rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter, cloth_means(run_dir, lo, hi)))
         points += [(g, th, c) for th, c, _ in windows(a, lo, hi, o.sub)]
     groups = sorted({r[0] for r in rows})
     print(f"# window [{lo}, {hi}] s; per run: mean speed (m/s), mean C_D, rms canopy tilt (deg), mean skirt "
           "diameter (m)")
     print("group run v cd tilt_rms diameter")
-    for g, d, v, cd, tilt, _, dia in sorted(rows, key=lambda r: r[:2]):
+    for g, d, v, cd, tilt, _, dia, _ in sorted(rows, key=lambda r: r[:2]):
         print(f"{g} {d} {v:.4f} {cd:.4f} {tilt:.2f} {dia:.4f}")
     print("# per group: n, mean, sample standard deviation s, standard error s/sqrt(n)")
     print("group n v_mean v_s cd_mean cd_s cd_se tilt_mean tilt_s diameter_mean diameter_s")
@@ -171,6 +228,7 @@ def main():
             op = np.array([r[5] for r in rows if r[0] == g])
             cols = " ".join(f"{stats(op[:, k])[0]:.4f} {stats(op[:, k])[1]:.4f}" for k in range(4))
             print(f"{g} {len(op)} {cols}")
+    cloth(rows, groups)
     if len(groups) > 1:
         print("# C_D differences: group_b - group_a, standard error sqrt(s_a^2/n_a + s_b^2/n_b), ratio b/a")
         print("a b diff se ratio")

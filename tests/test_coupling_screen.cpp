@@ -219,6 +219,37 @@ TEST_CASE_TEMPLATE_DEFINE(
         C::name, deg, uu, un, un_cpl, dp, law.pressure_jump(un), 100 * err, law.pressure_jump(uu));
     CHECK(std::fabs(err) < 0.05);
     CHECK(un_cpl == doctest::Approx(un).epsilon(0.05));
+    if constexpr (requires { s.coupling().cloth_sides(Eigen::Vector3d::UnitX()); }) {
+      // The cloth seen along the stream: its projection is the duct's cross-section (every
+      // x-line of cell centres crosses it once; at 45° one line meets it on a cell centre
+      // between two triangles and is counted on both neighbouring faces, 17 faces for 16), its
+      // wall pressures give the load the duct's momentum balance puts on it (the probes' dp on
+      // the cross-section: slip walls, the same U on both sides), and the air crossing it is
+      // the duct's flow U A: exactly when the cloth is normal to the stream, and within the
+      // staircase's count of faces when inclined (the y-faces of a cloth 4.6 and 8 cells long
+      // in x come in whole faces: Σ c_f A_f = A Σ_d m_d² up to a face).
+      const auto d = pf::model::duct_screen(1.0, 40, xs, 2, deg, 8);
+      const auto cs = s.coupling().cloth_sides(Eigen::Vector3d::UnitX());
+      const double dp_wall = cs.windward_pressure - cs.leeward_pressure, Q = uu * d.area();
+      const double e_area = cs.projected_area / d.area() - 1.0;
+      const double e_load = dp_wall * cs.projected_area / (dp * d.area()) - 1.0, e_q = cs.through_flow / Q - 1.0;
+      std::printf(
+          "  cloth sides along the stream: projected %.6f m2 (duct %.6f), wall dp %.2f Pa (probes %.2f, Ergun(u_n) "
+          "%.2f), load error %+.3f %%, through-flow %.5f m3/s (U A %.5f, %+.2f %%), %ld faces\n",
+          cs.projected_area, d.area(), dp_wall, dp, law.pressure_jump(un), 100 * e_load, cs.through_flow, Q, 100 * e_q,
+          long(cs.faces));
+      CHECK(std::fabs(e_area - (deg == 45.0 ? 1.0 / 16 : 0.0)) < 1e-9);
+      CHECK(std::fabs(e_load) < 0.01);
+      CHECK(std::fabs(e_q) < (deg == 0.0 ? 1e-6 : 0.10));
+      // Seen against the stream the sides swap; the flow along the cloth's normal stays.
+      const auto back = s.coupling().cloth_sides(-Eigen::Vector3d::UnitX());
+      CHECK(back.windward_pressure == cs.leeward_pressure);
+      CHECK(back.leeward_pressure == cs.windward_pressure);
+      CHECK(back.through_flow == cs.through_flow);
+      CHECK(back.projected_area == doctest::Approx(cs.projected_area).epsilon(1e-12));
+      CHECK_THROWS_WITH_AS(s.coupling().cloth_sides(Eigen::Vector3d(1, 1, 0)), doctest::Contains("unit vector"),
+                           pf::invalid_input);
+    }
   }
 }
 TEST_CASE_TEMPLATE_APPLY(inclined, ctu::couplings);

@@ -105,8 +105,13 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
     const auto full = parafsi::scene::run_drop(c);
 
     // Into another directory, without the first run's history.csv: the checkpoint carries
-    // the rows up to its time, so the history and summary cover the whole run.
+    // the rows up to its time, so the history and summary cover the whole run. The embedded
+    // coupling's cloth_pressure.csv is not in the checkpoint: it is carried as a user who
+    // continues in the run's directory has it (the rows after 0.06 s are written again).
     fs::copy_file(base / "a" / "checkpoint.ckpt", base / "b" / "checkpoint.ckpt");
+    const bool embedded = std::string(coupling) == "embedded";
+    CHECK(fs::exists(base / "a" / "cloth_pressure.csv") == embedded);
+    if (embedded) fs::copy_file(base / "a" / "cloth_pressure.csv", base / "b" / "cloth_pressure.csv");
     c.out = (base / "b").string();
     c.checkpoint_every = 0;
     c.restart = (base / "b" / "checkpoint.ckpt").string();
@@ -126,6 +131,7 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
     };
     CHECK(text(base / "b" / "history.csv") == text(base / "a" / "history.csv"));
     CHECK(text(base / "b" / "summary.csv") == text(base / "a" / "summary.csv"));
+    if (embedded) CHECK(text(base / "b" / "cloth_pressure.csv") == text(base / "a" / "cloth_pressure.csv"));
     // The step count is part of the restored state: the restarted run ends at the same count.
     CHECK(cont.steps == full.steps);
   }
@@ -154,6 +160,66 @@ TEST_CASE("drop restart: a run continued from a mid-run checkpoint is bit-identi
                          parafsi::invalid_input);
   }
   fs::remove_all(base);
+}
+
+// cloth_pressure.csv of an embedded drop (the pressures on the cloth's two sides along the
+// stream, scene/drop.hpp record_cloth): its header, one row per history row, and the signs a
+// loaded canopy has: overpressure inside (windward), suction behind (leeward), a load along
+// the stream, and a through-flow of mat544 that is a small fraction of the speed.
+TEST_CASE("drop: cloth_pressure.csv, the loaded canopy's two sides") {
+  namespace fs = std::filesystem;
+  parafsi::parallel::set_threads(1);
+  const fs::path dir = fs::temp_directory_path() / "parafsi_drop_cloth";
+  fs::remove_all(dir);
+  parafsi::scene::drop_config c;
+  c.resolution = "tiny";
+  c.coupling = "embedded";
+  c.t_end = 0.1;
+  c.initial_speed = 8.0;
+  c.quiet = true;
+  c.out = dir.string();
+  c.slice_times.clear();
+  const auto r = parafsi::scene::run_drop(c);
+  std::ifstream in(dir / "cloth_pressure.csv");
+  REQUIRE(in.good());
+  std::string line;
+  std::getline(in, line);
+  CHECK(line ==
+        "t,projected_area,windward_pressure,leeward_pressure,through_flow,windward_cp,leeward_cp,"
+        "pressure_drag_coefficient,through_fraction");
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::size_t a = 0;
+    while (a <= line.size()) {
+      const std::size_t b = std::min(line.find(',', a), line.size());
+      v.push_back(std::stod(line.substr(a, b - a)));
+      a = b + 1;
+    }
+    REQUIRE(v.size() == 9);
+    rows.push_back(v);
+  }
+  REQUIRE(rows.size() == r.history.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) CHECK(rows[i][0] == r.history[i].t);
+  const auto& e = rows.back();
+  const double S0 = M_PI / 4.0;  // D0 = 1 m
+  std::printf(
+      "cloth at %.3f s: S %.4f m2 (S0 %.4f), p_w %+.2f Pa, p_l %+.2f Pa, Cp_w %+.3f, Cp_l %+.3f, C_D,p %.3f, "
+      "through-fraction %.5f\n",
+      e[0], e[1], S0, e[2], e[3], e[5], e[6], e[7], e[8]);
+  CHECK(e[1] > 0.02 * S0);  // the canopy has opened from its packed 0.2 D0 (4 % of S0)
+  CHECK(e[1] < S0);
+  CHECK(e[5] > 0);
+  CHECK(e[6] < 0);
+  CHECK(e[7] > 0);
+  CHECK(e[8] > 0);
+  CHECK(e[8] < 0.05);
+  // The coefficients are the gauge pressures over q = ½ ρ V² at the payload's speed.
+  const double q = 0.5 * 1.18 * r.history.back().speed * r.history.back().speed;
+  CHECK(std::fabs(e[5] * q / e[2] - 1.0) < 1e-9);
+  CHECK(std::fabs(e[6] * q / e[3] - 1.0) < 1e-9);
+  CHECK(std::fabs(e[7] * q * S0 / ((e[2] - e[3]) * e[1]) - 1.0) < 1e-9);
+  fs::remove_all(dir);
 }
 
 TEST_CASE("drop on blocks with level subcycling: fewer, longer steps; a restart from a checkpoint is bit-identical") {

@@ -8,6 +8,13 @@ The script must give each run's means, the groups' means and standard deviations
 difference B - A with its standard error, and recover c_A, c_B and k from the fit (the
 residual is zero). It must also refuse a run shorter than the window, naming it.
 
+Each run also has a cloth_pressure.csv whose windward_cp steps from 0.9 to 1.1 at 5.5 s
+(its window mean is computed from the rows) and
+whose leeward_cp is a constant per run (A: -0.60, -0.62; B: -0.50, -0.54): the script must
+give the window means, the groups' means and standard deviations and the difference of the
+leeward sides B - A = +0.09 with its standard error; a run without the file leaves the
+section out by name.
+
   test_descent_ensemble.py SCRIPT     (exit 77, skipped, when no python3 with numpy is found)
 
 The script runs under this interpreter if it has numpy, else under the system's
@@ -36,6 +43,28 @@ HEAD = ("t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload
         "canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered")
 RUNS = {"A_o0": ("matA", 10.0, 0.84, 7.0), "A_o1": ("matA", 20.0, 0.81, 7.1),
         "B_o0": ("matB", 5.0, 0.7775, 7.2), "B_o1": ("matB", 15.0, 0.7575, 7.3)}
+LEEWARD = {"A_o0": -0.60, "A_o1": -0.62, "B_o0": -0.50, "B_o1": -0.54}
+CLOTH_HEAD = ("t,projected_area,windward_pressure,leeward_pressure,through_flow,windward_cp,leeward_cp,"
+              "pressure_drag_coefficient,through_fraction")
+
+
+def windward(t):
+    return 0.9 if t < 5.5 else 1.1
+
+
+def write_cloth(d, leeward, t_end=8.0):
+    with open(os.path.join(d, "cloth_pressure.csv"), "w") as f:
+        f.write(CLOTH_HEAD + "\n")
+        for i in range(int(round(t_end / 0.005)) + 1):
+            t = i * 0.005
+            w = windward(t)
+            f.write(f"{t},0.4,{30 * w},{30 * leeward},0.01,{w},{leeward},{(w - leeward) * 0.4 / 0.785},0.02\n")
+
+
+def window_mean_windward(lo=3.0, hi=8.0):
+    ts = [i * 0.005 for i in range(int(round(8.0 / 0.005)) + 1)]
+    sel = [windward(t) for t in ts if lo <= t <= hi]
+    return sum(sel) / len(sel)
 
 
 def write_run(root, name, fabric, tilt, cd, v, t_end=8.0):
@@ -79,6 +108,8 @@ def main():
 
     with tempfile.TemporaryDirectory() as root:
         dirs = [write_run(root, k, *v) for k, v in RUNS.items()]
+        for k, d in zip(RUNS, dirs):
+            write_cloth(d, LEEWARD[k])
         r = subprocess.run([PYTHON, script, *dirs, "--window", "3", "8"], capture_output=True, text=True)
         check(r.returncode == 0, f"exit {r.returncode}: {r.stderr}")
         out = r.stdout
@@ -102,6 +133,25 @@ def main():
         check(bool(kline) and "k = -1.000e-04" in kline[0], f"slope: {kline}")
         opening = {w[0]: w for w in table(out, "group n t_f t_f_s t_mo t_mo_s t_p t_p_s F_p F_p_s")}
         check(close(opening["matA"][8], 35.0, 1e-4), f"F_p mean: {opening['matA']}")
+        # The cloth's two sides: run means, group means and deviations, the leeward difference.
+        cols = "windward_cp leeward_cp pressure_drag_coefficient through_fraction"
+        crun = {os.path.basename(w[1]): w for w in table(out, "group run " + cols)}
+        ww = window_mean_windward()
+        for name, lw in LEEWARD.items():
+            w = crun[name]
+            check(close(w[2], ww, 1e-5) and close(w[3], lw, 1e-5) and close(w[4], (ww - lw) * 0.4 / 0.785, 1e-4)
+                  and close(w[5], 0.02, 1e-5), f"cloth run {name}: {w}")
+        cg = {w[0]: w for w in table(out, "group n " + " ".join(f"{c} {c}_s" for c in cols.split()))}
+        sLA, sLB = math.sqrt(2) * 0.01, math.sqrt(2) * 0.02
+        check(close(cg["matA"][4], -0.61, 1e-5) and close(cg["matA"][5], sLA, 1e-4)
+              and close(cg["matB"][4], -0.52, 1e-5) and close(cg["matB"][5], sLB, 1e-4), f"cloth groups: {cg}")
+        cd_ = table(out, "a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se")[0]
+        check(close(cd_[2], 0.0, 1e-6) and close(cd_[4], 0.09, 1e-5)
+              and close(cd_[5], math.sqrt(sLA**2 / 2 + sLB**2 / 2), 1e-4), f"cloth difference: {cd_}")
+        os.remove(os.path.join(dirs[3], "cloth_pressure.csv"))
+        r = subprocess.run([PYTHON, script, *dirs, "--window", "3", "8"], capture_output=True, text=True)
+        check(r.returncode == 0 and "not every run has a cloth_pressure.csv" in r.stdout,
+              f"a run without cloth_pressure.csv: exit {r.returncode}, {r.stdout[-300:]}")
         # A run that stops before the window's end is refused by name.
         short = write_run(root, "C_o0", "matC", 5.0, 0.8, 7.0, t_end=6.0)
         r = subprocess.run([PYTHON, script, dirs[0], short, "--window", "3", "8"], capture_output=True,

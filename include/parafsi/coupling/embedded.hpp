@@ -149,6 +149,32 @@ struct embedded_diagnostics {
   std::vector<double> through_flow;  ///< per element: Σ u_p A_face/k along +n_e (m³/s), last stage
 };
 
+/// The pressures on the two sides of the cloth seen along a direction e (embedded::cloth_sides),
+/// from the wall pressures p*_L, p*_R of the patched faces (file comment, "Face flux"), each the
+/// mean over the step's stages with their weights β_s (as the load is). A face of normal n_f
+/// and area A_f counts with the weight w_f = A_f |n_f·e|; its windward side is the one whose
+/// pressure pushes the cloth along +e: the low side when n_f·e > 0, else the high side. So
+///   (windward_pressure − leeward_pressure) · projected_area = Σ_f A_f (p*_L − p*_R) n_f·e,
+/// the cloth's pressure load along e (the load without its swept terms ∝ (w − w_g); the
+/// porous momentum leaves one side and enters the other, so it is not in the load). The
+/// staircase of a plane cloth of area A and unit normal m has the area A |m_d| on the faces
+/// of axis d, so projected_area is A Σ_d |m_d| |e_d|: A |m·e| when e is along a grid axis
+/// (the drop's box axis follows the payload's velocity).
+struct cloth_side_means {
+  double projected_area = 0;     ///< S = Σ_f A_f |n_f·e| (m²)
+  double windward_pressure = 0;  ///< Σ_f w_f p*_windward / S (Pa; the fluid's pressure, so scaled with PGS)
+  double leeward_pressure = 0;   ///< Σ_f w_f p*_leeward / S (Pa)
+  /// Σ_f s_f u_n,f c_f A_f (m³/s): the air crossing the cloth along its elements' normals
+  /// (the same for every e). u_n,f = Δp_por⁻¹((p*_L − p*_R)/k) is the fabric law's normal
+  /// through-velocity at the face's wall pressure jump (each stage, then the stage-weighted
+  /// mean), c_f A_f = |m_f·n_f| A_f the cloth area the face stands for (m_f the unit mean cloth
+  /// normal of its layers; a plane cloth: Σ_f c_f A_f = A) and s_f the mean over its layers of
+  /// sign(n_element·n_f). Not the faces' own u_p, which also carries the flow along a curved
+  /// cloth through its staircase; with the law on the face velocity the faces pass more.
+  double through_flow = 0;
+  index_t faces = 0;  ///< the faces with n_f·e ≠ 0
+};
+
 /// `OneSided`: reconstruct the cells beside a membrane face from their own side (second
 /// order up to the membrane; see `one_sided_reconstruction`; docs/coupling.md §7: an acoustic
 /// pulse reflects to order 2.2 instead of 1.3, a flexible porous sheet settles as with
@@ -189,6 +215,41 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   }
   /// Area of the blocking elements (m², current geometry at the last exchange).
   double coupled_area() const { return area_; }
+  /// The pressures on the two sides of the cloth along the unit direction `e` (world frame;
+  /// the stream's direction relative to the cloth: −V for a canopy falling at V) and the air
+  /// crossing it, over the last step (definitions: cloth_side_means).
+  cloth_side_means cloth_sides(const Eigen::Vector3d& e) const {
+    require(std::isfinite(e.squaredNorm()) && std::fabs(e.norm() - 1.0) < 1e-9,
+            "coupling::embedded::cloth_sides: the direction must be a unit vector, got (", e.x(), ", ", e.y(), ", ",
+            e.z(), ")");
+    cloth_side_means r;
+    double pw = 0, pl = 0;
+    for (std::size_t i = 0; i < faces_.size() && i < side_p_.size(); ++i) {
+      const face_rec& fr = faces_[i];
+      const double ne = face_R_.col(fr.axis).dot(e), w = fr.area * std::fabs(ne);
+      const auto& p = side_p_[i];
+      if (w > 0) {
+        r.projected_area += w;
+        pw += w * (ne > 0 ? p[0] : p[1]);
+        pl += w * (ne > 0 ? p[1] : p[0]);
+        ++r.faces;
+      }
+      Eigen::Vector3d m = Eigen::Vector3d::Zero();
+      double sign = 0;
+      for (int q = 0; q < fr.n; ++q) {
+        m += crossings_[std::size_t(fr.first + q)].m;
+        sign += crossings_[std::size_t(fr.first + q)].sign / double(fr.n);
+      }
+      const double mn = m.norm();
+      if (mn > 0)  // the face stands for the cloth area c A_f, c = m·n_f
+        r.through_flow += sign * p[2] * fr.area * std::fabs(m.dot(face_R_.col(fr.axis))) / mn;
+    }
+    if (r.projected_area > 0) {
+      r.windward_pressure = pw / r.projected_area;
+      r.leeward_pressure = pl / r.projected_area;
+    }
+    return r;
+  }
   /// Checkpoint (io/archive.hpp; after attach): nothing carries over between steps (the
   /// faces, loads and impedance terms are rebuilt by every exchange); the set-up is compared.
   template <class Archive, class Self>
@@ -210,6 +271,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     beta_.assign(std::size_t(Time::stages), 1.0);
     for (int st = 0; st < Time::stages; ++st)
       for (int r = st; r < Time::stages; ++r) beta_[std::size_t(st)] *= Time::b[std::size_t(r)];
+    beta_sum_ = 0;
+    for (double b : beta_) beta_sum_ += b;
     open_.assign(tris_.size(), 0);
     for (index_t e : open_list_) {
       require(e >= 0 && std::size_t(e) < tris_.size(), "coupling::embedded: open element ", e, " outside [0, ",
@@ -274,6 +337,8 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
       }
       impedance_setup(f.view(), nd);
     }
+    face_R_ = pose.R;
+    side_p_.assign(faces_.size(), {0.0, 0.0, 0.0});
     patch_list_.clear();
     for (const auto& fr : faces_) patch_list_.push_back({fr.high, fr.axis});
   }
@@ -309,6 +374,17 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     diag_.work_fluid += wdt * (lo.E - hi.E);
     diag_.mass_defect += wdt * (lo.rho - hi.rho);
     diag_.max_through_velocity = std::max(diag_.max_through_velocity, std::fabs(up));
+    {  // the wall pressures p*_K = F_K.m·n − F_K.ρ u_m (the star states move at u_m along n)
+      const Eigen::Vector3d n(fc.n.x, fc.n.y, fc.n.z);
+      double w = 0;
+      for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
+      const double um = w / double(fr.n) + up, b = beta_[std::size_t(stage)] / beta_sum_;
+      auto& p = side_p_[fi];
+      const double psL = mL.dot(n) - lo.rho * um, psR = mR.dot(n) - hi.rho * um;
+      p[0] += b * psL;
+      p[1] += b * psR;
+      p[2] += b * por_.through_velocity((psL - psR) / double(fr.n));  // the law's u_n: Δp = k Δp_por(u_n)
+    }
     if (stage + 1 == int(beta_.size()))
       for (int q = 0; q < fr.n; ++q) {
         const auto& cr = crossings_[std::size_t(fr.first + q)];
@@ -769,6 +845,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   std::vector<face_rec> faces_;
   std::vector<crossing> crossings_;
   std::vector<Eigen::Vector3d> face_J_, node_J_, node_v0_;
+  /// Per face, the step's stage-weighted means of p*_L, p*_R and u_p (cloth_sides).
+  std::vector<std::array<double, 3>> side_p_;
+  Eigen::Matrix3d face_R_ = Eigen::Matrix3d::Identity();  ///< the box axes at the last exchange
+  double beta_sum_ = 1;                                   ///< Σ_s β_s
   std::vector<Eigen::Matrix3d> node_C_;
   std::vector<index_t> touched_;
   std::vector<double> beta_;

@@ -540,6 +540,7 @@ class drop_run {
     res.regrids = regrids_;
     res.canopy_travel_ratio = travel_ratio_;
     if (mesh_csv_) mesh_csv_->close();
+    if (cloth_csv_) cloth_csv_->close();
     if (!c_.quiet)  // subcycled, a step is one of the coarsest level, holding 2^levels of the finest
       std::fprintf(stderr,
                    "parachute_drop: %ld fluid steps%s, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
@@ -656,19 +657,65 @@ class drop_run {
       // mesh.csv: the block mesh after every regrid that changed it.
       std::vector<std::string> cols{"t", "step", "blocks", "cells"};
       for (int l = 0; l <= levels_; ++l) cols.push_back("cells_level_" + std::to_string(l));
-      io::csv_options mo;
-      if (!c_.restart.empty()) mo.resume_after = s_.time();
-      mesh_csv_.emplace(out() / "mesh.csv", std::move(cols), mo);
+      mesh_csv_.emplace(out() / "mesh.csv", std::move(cols), resume_options());
     }
+    if constexpr (cloth_sides)
+      cloth_csv_.emplace(out() / "cloth_pressure.csv",
+                         std::vector<std::string>(std::begin(cloth_columns), std::end(cloth_columns)),
+                         resume_options());
     if (c_.vtk_every > 0) {
       std::filesystem::create_directories(out() / "vtk");
       pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
     }
   }
 
+  /// A CSV beside history.csv: a new file, or on a restart the old one's rows up to now.
+  io::csv_options resume_options() const {
+    io::csv_options o;
+    if (!c_.restart.empty()) o.resume_after = s_.time();
+    return o;
+  }
+
+  /// The columns of cloth_pressure.csv (embedded coupling; definitions in record_cloth).
+  static constexpr const char* cloth_columns[] = {
+      "t",           "projected_area", "windward_pressure",         "leeward_pressure", "through_flow",
+      "windward_cp", "leeward_cp",     "pressure_drag_coefficient", "through_fraction"};
+
+  /// A row of cloth_pressure.csv: the canopy's cloth seen along the stream e = −V/|V| (V the
+  /// payload's velocity; the box axis when it is at rest), from the embedded coupling's wall
+  /// pressures of the last step (coupling::cloth_side_means): S = projected_area (m²), the
+  /// windward and leeward pressures as physical gauge pressures p − p∞ (Pa; PGS leaves
+  /// differences physical), the through-flow Q (m³/s) along the canopy elements' normals (the
+  /// flat pattern's +z: out of the canopy, from its mouth side to its crown side, as the
+  /// fabric law gives it at each face's wall pressure jump); with q = ½ ρ∞ |V|²,
+  /// windward_cp and leeward_cp = (p − p∞)/q, pressure_drag_coefficient = (p_w − p_l) S/(q S0)
+  /// (the cloth's pressure load along the stream on S0 = π D0²/4; in steady descent the
+  /// history's drag_coefficient less the payload's and the lines' drag and the swept terms),
+  /// through_fraction = Q/(|V| S); the four are nan while the payload is at rest.
+  void record_cloth(const io::drop_history_row& r) {
+    if constexpr (cloth_sides) {
+      if (!cloth_csv_) return;
+      const Eigen::Vector3d V = structure::payload(s_.structure()).body().mass_centre_velocity();
+      const double v = V.norm();
+      const Eigen::Vector3d e = v > 0 ? Eigen::Vector3d(-V / v) : Eigen::Vector3d(s_.fluid().pose().R.col(2));
+      const auto cs = s_.coupling().cloth_sides(e.normalized());
+      const double q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
+      const double pw = cs.windward_pressure - q_inf, pl = cs.leeward_pressure - q_inf;
+      const double q = 0.5 * su_.params.air_density * v * v, nan = std::numeric_limits<double>::quiet_NaN();
+      const bool moving = q > 0;
+      cloth_csv_->row({r.t, cs.projected_area, cs.projected_area > 0 ? pw : 0.0, cs.projected_area > 0 ? pl : 0.0,
+                       cs.through_flow, moving ? pw / q : nan, moving ? pl / q : nan,
+                       moving ? (pw - pl) * cs.projected_area / (q * su_.params.nominal_area()) : nan,
+                       moving && cs.projected_area > 0 ? cs.through_flow / (v * cs.projected_area) : nan});
+    } else {
+      (void)r;
+    }
+  }
+
   /// The history row of now, the αM guard, the row to history.csv.
   void record(std::vector<io::drop_history_row>& history) {
     history.push_back(observe_(s_.time(), s_.structure()));
+    record_cloth(history.back());
     const io::drop_history_row& r = history.back();
     const double alpha = su_.alpha;
     if (alpha > 1.0 && !warned_mach_ && !c_.quiet && alpha * r.speed / c_air_ > 0.3) {
@@ -888,8 +935,11 @@ class drop_run {
                               -1, s_.time());
   }
 
-  int levels_ = 0;                            ///< block mesh: the finest level
-  std::optional<io::csv_writer> mesh_csv_;    ///< block mesh: mesh.csv
+  int levels_ = 0;                          ///< block mesh: the finest level
+  std::optional<io::csv_writer> mesh_csv_;  ///< block mesh: mesh.csv
+  /// The coupling reports the pressures on the two sides of the cloth (embedded).
+  static constexpr bool cloth_sides = requires(const Coupling& c) { c.cloth_sides(Eigen::Vector3d::UnitZ()); };
+  std::optional<io::csv_writer> cloth_csv_;   ///< embedded coupling: cloth_pressure.csv
   std::vector<Eigen::Vector3d> wall_points_;  ///< mixing length: the structure's nodes in box coordinates
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
   /// Block mesh: the longest step the last regrid's canopy buffer allows (drop_canopy_travel).

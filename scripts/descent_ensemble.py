@@ -21,7 +21,8 @@ fabric at --grid-offset 0, 0.25, 0.5, and gives:
 * per run and per group, when every run has cloth_pressure.csv (the embedded coupling's): the
   window's means of windward_cp and leeward_cp (the cloth's wall pressures, windward and
   leeward, on q of the payload's speed), pressure_drag_coefficient (their difference on the
-  projected area, over S0) and through_fraction (the fabric law's through-flow over |V| S),
+  projected area, over S0), through_fraction (the fabric law's through-flow over |V| S) and
+  projected_area S (m^2),
   with the groups' means and sample standard deviations and the pairwise differences of the
   two sides: which side of the cloth a group difference in C_D comes from;
 * the drag at equal attitude: a least-squares fit C_D = c_g + k theta_rms^2 with one
@@ -101,7 +102,7 @@ def opening(run_dir):
         sys.exit(f"descent_ensemble: {path}: no t_f, t_mo, t_p, F_p columns")
 
 
-CLOTH = ("windward_cp", "leeward_cp", "pressure_drag_coefficient", "through_fraction")
+CLOTH = ("windward_cp", "leeward_cp", "pressure_drag_coefficient", "through_fraction", "projected_area")
 
 
 def cloth_means(run_dir, lo, hi):
@@ -165,11 +166,11 @@ def cloth(rows, groups):
         print(f"{g} {len(sel)} " + " ".join(f"{m:.5f} {s:.5f}" for m, s, _ in st))
     if len(groups) > 1:
         print("# the two sides' differences: group_b - group_a, standard error sqrt(s_a^2/n_a + s_b^2/n_b)")
-        print("a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se")
+        print("a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se projected_area_diff se")
         for ga, gb in itertools.combinations(groups, 2):
             (na, sa), (nb, sb) = means[ga], means[gb]
             out = []
-            for k in range(3):
+            for k in (0, 1, 2, 4):
                 d = sb[k][0] - sa[k][0]
                 se = np.sqrt(sa[k][1] ** 2 / na + sb[k][1] ** 2 / nb) if na > 1 and nb > 1 else np.nan
                 out.append(f"{d:+.5f} {se:.5f}")

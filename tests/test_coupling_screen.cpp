@@ -221,8 +221,9 @@ TEST_CASE_TEMPLATE_DEFINE(
     CHECK(un_cpl == doctest::Approx(un).epsilon(0.05));
     if constexpr (requires { s.coupling().cloth_sides(Eigen::Vector3d::UnitX()); }) {
       // The cloth seen along the stream: its projection is the duct's cross-section (every
-      // x-line of cell centres crosses it once; at 45° one line meets it on a cell centre
-      // between two triangles and is counted on both neighbouring faces, 17 faces for 16), its
+      // x-line of cell centres crosses it once; at 45° every line meets it on a cell centre,
+      // on the diagonal between two triangles, and whether the two crossings fall on one face
+      // or on both neighbours is decided by round-off: 16 to 32 faces for 16), its
       // wall pressures give the load the duct's momentum balance puts on it (the probes' dp on
       // the cross-section: slip walls, the same U on both sides), and the air crossing it is
       // the duct's flow U A: exactly when the cloth is normal to the stream, and within the
@@ -238,9 +239,17 @@ TEST_CASE_TEMPLATE_DEFINE(
           "%.2f), load error %+.3f %%, through-flow %.5f m3/s (U A %.5f, %+.2f %%), %ld faces\n",
           cs.projected_area, d.area(), dp_wall, dp, law.pressure_jump(un), 100 * e_load, cs.through_flow, Q, 100 * e_q,
           long(cs.faces));
-      CHECK(std::fabs(e_area - (deg == 45.0 ? 1.0 / 16 : 0.0)) < 1e-9);
-      CHECK(std::fabs(e_load) < 0.01);
-      CHECK(std::fabs(e_q) < (deg == 0.0 ? 1e-6 : 0.10));
+      if (deg == 45.0) {
+        CHECK(e_area > -1e-9);
+        CHECK(e_area < 1.0 + 1e-9);
+        CHECK(std::fabs(e_load) < 3e-3);
+        CHECK(std::fabs(e_q) < 0.10);
+      } else {
+        CHECK(std::fabs(e_area) < 1e-9);
+        CHECK(std::fabs(e_load) < 1e-4);
+        if (deg == 0.0) CHECK(std::fabs(e_q) < 1e-6);
+        if (deg == 30.0) CHECK((e_q < 0 && e_q > -0.05));  // the staircase's y-faces: 8 for 9.2
+      }
       // Seen against the stream the sides swap; the flow along the cloth's normal stays.
       const auto back = s.coupling().cloth_sides(-Eigen::Vector3d::UnitX());
       CHECK(back.windward_pressure == cs.leeward_pressure);

@@ -134,19 +134,20 @@ def main():
         opening = {w[0]: w for w in table(out, "group n t_f t_f_s t_mo t_mo_s t_p t_p_s F_p F_p_s")}
         check(close(opening["matA"][8], 35.0, 1e-4), f"F_p mean: {opening['matA']}")
         # The cloth's two sides: run means, group means and deviations, the leeward difference.
-        cols = "windward_cp leeward_cp pressure_drag_coefficient through_fraction"
+        cols = "windward_cp leeward_cp pressure_drag_coefficient through_fraction projected_area"
         crun = {os.path.basename(w[1]): w for w in table(out, "group run " + cols)}
         ww = window_mean_windward()
         for name, lw in LEEWARD.items():
             w = crun[name]
             check(close(w[2], ww, 1e-5) and close(w[3], lw, 1e-5) and close(w[4], (ww - lw) * 0.4 / 0.785, 1e-4)
-                  and close(w[5], 0.02, 1e-5), f"cloth run {name}: {w}")
+                  and close(w[5], 0.02, 1e-5) and close(w[6], 0.4, 1e-5), f"cloth run {name}: {w}")
         cg = {w[0]: w for w in table(out, "group n " + " ".join(f"{c} {c}_s" for c in cols.split()))}
         sLA, sLB = math.sqrt(2) * 0.01, math.sqrt(2) * 0.02
         check(close(cg["matA"][4], -0.61, 1e-5) and close(cg["matA"][5], sLA, 1e-4)
               and close(cg["matB"][4], -0.52, 1e-5) and close(cg["matB"][5], sLB, 1e-4), f"cloth groups: {cg}")
-        cd_ = table(out, "a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se")[0]
-        check(close(cd_[2], 0.0, 1e-6) and close(cd_[4], 0.09, 1e-5)
+        cd_ = table(out, "a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se projected_area_diff "
+                         "se")[0]
+        check(close(cd_[2], 0.0, 1e-6) and close(cd_[4], 0.09, 1e-5) and close(cd_[8], 0.0, 1e-6)
               and close(cd_[5], math.sqrt(sLA**2 / 2 + sLB**2 / 2), 1e-4), f"cloth difference: {cd_}")
         os.remove(os.path.join(dirs[3], "cloth_pressure.csv"))
         r = subprocess.run([PYTHON, script, *dirs, "--window", "3", "8"], capture_output=True, text=True)

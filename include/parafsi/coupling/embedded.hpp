@@ -159,7 +159,8 @@ struct embedded_diagnostics {
 /// porous momentum leaves one side and enters the other, so it is not in the load). The
 /// staircase of a plane cloth of area A and unit normal m has the area A |m_d| on the faces
 /// of axis d, so projected_area is A Σ_d |m_d| |e_d|: A |m·e| when e is along a grid axis
-/// (the drop's box axis follows the payload's velocity).
+/// (in the drop the following box's axis turns to the payload's velocity; a fixed box's does
+/// not). "The step" is the last step of the coupling: subcycled, the last finest-level step.
 struct cloth_side_means {
   double projected_area = 0;     ///< S = Σ_f A_f |n_f·e| (m²)
   double windward_pressure = 0;  ///< Σ_f w_f p*_windward / S (Pa; the fluid's pressure, so scaled with PGS)
@@ -170,7 +171,8 @@ struct cloth_side_means {
   /// mean), c_f A_f = |m_f·n_f| A_f the cloth area the face stands for (m_f the unit mean cloth
   /// normal of its layers; a plane cloth: Σ_f c_f A_f = A) and s_f the mean over its layers of
   /// sign(n_element·n_f). Not the faces' own u_p, which also carries the flow along a curved
-  /// cloth through its staircase; with the law on the face velocity the faces pass more.
+  /// cloth through its staircase. With the law on the face velocity (law_on = face_velocity)
+  /// the law's inverse is each face's own u_p and the faces pass more than this sum.
   double through_flow = 0;
   index_t faces = 0;  ///< the faces with n_f·e ≠ 0
 };
@@ -374,8 +376,9 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     diag_.work_fluid += wdt * (lo.E - hi.E);
     diag_.mass_defect += wdt * (lo.rho - hi.rho);
     diag_.max_through_velocity = std::max(diag_.max_through_velocity, std::fabs(up));
-    {  // the wall pressures p*_K = F_K.m·n − F_K.ρ u_m (the star states move at u_m along n)
-      const Eigen::Vector3d n(fc.n.x, fc.n.y, fc.n.z);
+    {  // the wall pressures p*_K = F_K.m·n − F_K.ρ u_m (the star states move at u_m along n;
+       // n from the exchange's box axes: a block mesh replays a face with patch, stage and area only)
+      const Eigen::Vector3d n = face_R_.col(fr.axis);
       double w = 0;
       for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
       const double um = w / double(fr.n) + up, b = beta_[std::size_t(stage)] / beta_sum_;
@@ -845,7 +848,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   std::vector<face_rec> faces_;
   std::vector<crossing> crossings_;
   std::vector<Eigen::Vector3d> face_J_, node_J_, node_v0_;
-  /// Per face, the step's stage-weighted means of p*_L, p*_R and u_p (cloth_sides).
+  /// Per face, the step's stage-weighted means of p*_L, p*_R and the fabric law's u_n (cloth_sides).
   std::vector<std::array<double, 3>> side_p_;
   Eigen::Matrix3d face_R_ = Eigen::Matrix3d::Identity();  ///< the box axes at the last exchange
   double beta_sum_ = 1;                                   ///< Σ_s β_s

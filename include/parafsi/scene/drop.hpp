@@ -691,7 +691,8 @@ class drop_run {
   /// windward_cp and leeward_cp = (p − p∞)/q, pressure_drag_coefficient = (p_w − p_l) S/(q S0)
   /// (the cloth's pressure load along the stream on S0 = π D0²/4; in steady descent the
   /// history's drag_coefficient less the payload's and the lines' drag and the swept terms),
-  /// through_fraction = Q/(|V| S); the four are nan while the payload is at rest.
+  /// through_fraction = Q/(|V| S). The two pressures are nan before the first step (no faces
+  /// yet), the four coefficients also while the payload is at rest.
   void record_cloth(const io::drop_history_row& r) {
     if constexpr (cloth_sides) {
       if (!cloth_csv_) return;
@@ -702,11 +703,11 @@ class drop_run {
       const double q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
       const double pw = cs.windward_pressure - q_inf, pl = cs.leeward_pressure - q_inf;
       const double q = 0.5 * su_.params.air_density * v * v, nan = std::numeric_limits<double>::quiet_NaN();
-      const bool moving = q > 0;
-      cloth_csv_->row({r.t, cs.projected_area, cs.projected_area > 0 ? pw : 0.0, cs.projected_area > 0 ? pl : 0.0,
-                       cs.through_flow, moving ? pw / q : nan, moving ? pl / q : nan,
+      const bool seen = cs.projected_area > 0, moving = seen && q > 0;
+      cloth_csv_->row({r.t, cs.projected_area, seen ? pw : nan, seen ? pl : nan, cs.through_flow, moving ? pw / q : nan,
+                       moving ? pl / q : nan,
                        moving ? (pw - pl) * cs.projected_area / (q * su_.params.nominal_area()) : nan,
-                       moving && cs.projected_area > 0 ? cs.through_flow / (v * cs.projected_area) : nan});
+                       moving ? cs.through_flow / (v * cs.projected_area) : nan});
     } else {
       (void)r;
     }

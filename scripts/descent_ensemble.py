@@ -25,6 +25,8 @@ fabric at --grid-offset 0, 0.25, 0.5, and gives:
   projected_area S (m^2),
   with the groups' means and sample standard deviations and the pairwise differences of the
   two sides: which side of the cloth a group difference in C_D comes from;
+* the same fit of windward_cp and of leeward_cp when every run has cloth_pressure.csv: which
+  side of the cloth differs between groups at equal swing;
 * the drag at equal attitude: a least-squares fit C_D = c_g + k theta_rms^2 with one
   intercept c_g per group and a slope k shared by all (the axial drag of a canopy is even
   in its tilt), over the runs' windows or, with --sub S, over consecutive sub-windows of S
@@ -72,18 +74,27 @@ def group_of(run_dir, how):
     return m.group(1)
 
 
+def window_masks(t, lo, hi, sub):
+    """Row masks of [lo, hi] or of its consecutive sub-windows of `sub` s that hold two rows or more."""
+    edges = [lo, hi] if not sub else list(np.arange(lo, hi - 1e-9, sub)) + [hi]
+    masks = [(t >= w0) & (t <= w1) for w0, w1 in zip(edges[:-1], edges[1:])]
+    return [m for m in masks if m.sum() >= 2]
+
+
 def windows(a, lo, hi, sub):
     """(rms tilt, mean C_D, mean speed) over [lo, hi] or its consecutive sub-windows of `sub` s."""
-    t = a["t"]
     tilt = np.hypot(a["canopy_phi_x"], a["canopy_phi_y"])
-    edges = [lo, hi] if not sub else list(np.arange(lo, hi - 1e-9, sub)) + [hi]
-    out = []
-    for w0, w1 in zip(edges[:-1], edges[1:]):
-        m = (t >= w0) & (t <= w1)
-        if m.sum() < 2:
-            continue
-        out.append((np.sqrt(np.mean(tilt[m] ** 2)), a["drag_coefficient"][m].mean(), a["speed"][m].mean()))
-    return out
+    return [(np.sqrt(np.mean(tilt[m] ** 2)), a["drag_coefficient"][m].mean(), a["speed"][m].mean())
+            for m in window_masks(a["t"], lo, hi, sub)]
+
+
+def cloth_windows(run_dir, lo, hi, sub):
+    """(windward_cp, leeward_cp) means of cloth_pressure.csv over the windows of `windows`, or None."""
+    path = os.path.join(run_dir, "cloth_pressure.csv")
+    if not os.path.isfile(path):
+        return None
+    a = np.genfromtxt(path, delimiter=",", names=True)
+    return [(a["windward_cp"][m].mean(), a["leeward_cp"][m].mean()) for m in window_masks(a["t"], lo, hi, sub)]
 
 
 def opening(run_dir):
@@ -187,7 +198,7 @@ def main():
     lo, hi = o.window
     if not hi > lo or o.sub < 0 or (o.sub and o.sub > hi - lo):
         sys.exit("descent_ensemble: the window's end must follow its start, and 0 <= --sub <= its length")
-    rows, points = [], []
+    rows, points, side_points = [], [], []
     for r in o.runs:
         path, a = load(r)
         require_finite(path, a, lo)
@@ -202,7 +213,13 @@ def main():
         win = (a["t"] >= lo) & (a["t"] <= hi)
         diameter = a["canopy_diameter"][win].mean() if "canopy_diameter" in a.dtype.names else np.nan
         rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter, cloth_means(run_dir, lo, hi)))
-        points += [(g, th, c) for th, c, _ in windows(a, lo, hi, o.sub)]
+        sw = windows(a, lo, hi, o.sub)
+        points += [(g, th, c) for th, c, _ in sw]
+        cw = cloth_windows(run_dir, lo, hi, o.sub)
+        if cw is None or len(cw) != len(sw):
+            side_points = None
+        elif side_points is not None:
+            side_points += [(g, th, w, le) for (th, _, _), (w, le) in zip(sw, cw)]
     groups = sorted({r[0] for r in rows})
     print(f"# window [{lo}, {hi}] s; per run: mean speed (m/s), mean C_D, rms canopy tilt (deg), mean skirt "
           "diameter (m)")
@@ -237,21 +254,29 @@ def main():
             (na, ca, sa), (nb, cb, sb) = summary[ga], summary[gb]
             se = np.sqrt(sa**2 / na + sb**2 / nb) if na > 1 and nb > 1 else np.nan
             print(f"{ga} {gb} {cb - ca:+.4f} {se:.4f} {cb / ca:.4f}")
-    fit = attitude_fit(points, groups)
     what = f"sub-windows of {o.sub} s" if o.sub else "whole windows"
+    report_fit("C_D", points, groups, rows, what, "")
+    if side_points:
+        for k, name in ((2, "windward_cp"), (3, "leeward_cp")):
+            report_fit(name, [(p[0], p[1], p[k]) for p in side_points], groups, rows, what, f"{name} ")
+
+
+def report_fit(name, points, groups, rows, what, prefix):
+    """The fit y = c_group + k theta_rms^2 of `points` (group, tilt, y): slope, intercepts, their differences."""
+    fit = attitude_fit(points, groups)
     if fit is None:
-        print(f"# attitude fit C_D = c_group + k theta_rms^2 over {what}: too few points or no spread in tilt")
+        print(f"# attitude fit {name} = c_group + k theta_rms^2 over {what}: too few points or no spread in tilt")
         return
     coef, cov, rms, dof = fit
     se = np.sqrt(np.diag(cov))
-    print(f"# attitude fit C_D = c_group + k theta_rms^2 over {what}: {len(points)} points, {dof} degrees of "
+    print(f"# attitude fit {name} = c_group + k theta_rms^2 over {what}: {len(points)} points, {dof} degrees of "
           f"freedom, rms residual {rms:.4f}; k = {coef[-1]:.3e} +- {se[-1]:.1e} per deg^2")
-    print("group runs c_at_zero_tilt se")
+    print(f"{prefix}group runs c_at_zero_tilt se")
     for i, g in enumerate(groups):
         print(f"{g} {sum(r[0] == g for r in rows)} {coef[i]:.4f} {se[i]:.4f}")
     if len(groups) > 1:
         print("# intercept differences at equal attitude: b - a, standard error from the fit's covariance")
-        print("a b diff se")
+        print(f"{prefix}a b diff se")
         for (i, ga), (j, gb) in itertools.combinations(enumerate(groups), 2):
             d = coef[j] - coef[i]
             print(f"{ga} {gb} {d:+.4f} {np.sqrt(cov[i, i] + cov[j, j] - 2 * cov[i, j]):.4f}")

@@ -10,10 +10,12 @@ residual is zero). It must also refuse a run shorter than the window, naming it.
 
 Each run also has a cloth_pressure.csv whose windward_cp steps from 0.9 to 1.1 at 5.5 s
 (its window mean is computed from the rows) and
-whose leeward_cp is a constant per run (A: -0.60, -0.62; B: -0.50, -0.54): the script must
-give the window means, the groups' means and standard deviations and the difference of the
-leeward sides B - A = +0.09 with its standard error; a run without the file leaves the
-section out by name.
+whose leeward_cp is a constant per run built as c_g + k theta^2 (c_A = -0.62, c_B = -0.52,
+k = +5e-5 per deg^2: A -0.615, -0.600; B -0.51875, -0.50875): the script must give the window
+means, the groups' means and standard deviations, the difference of the leeward sides
+B - A = +0.09375 with its standard error, and from the attitude fit of each side the
+leeward intercepts, their difference +0.10 and k, and equal windward intercepts; a run
+without the file leaves the section out by name.
 
   test_descent_ensemble.py SCRIPT     (exit 77, skipped, when no python3 with numpy is found)
 
@@ -43,7 +45,7 @@ HEAD = ("t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload
         "canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered")
 RUNS = {"A_o0": ("matA", 10.0, 0.84, 7.0), "A_o1": ("matA", 20.0, 0.81, 7.1),
         "B_o0": ("matB", 5.0, 0.7775, 7.2), "B_o1": ("matB", 15.0, 0.7575, 7.3)}
-LEEWARD = {"A_o0": -0.60, "A_o1": -0.62, "B_o0": -0.50, "B_o1": -0.54}
+LEEWARD = {"A_o0": -0.615, "A_o1": -0.600, "B_o0": -0.51875, "B_o1": -0.50875}
 CLOTH_HEAD = ("t,projected_area,windward_pressure,leeward_pressure,through_flow,windward_cp,leeward_cp,"
               "pressure_drag_coefficient,through_fraction")
 
@@ -142,13 +144,21 @@ def main():
             check(close(w[2], ww, 1e-5) and close(w[3], lw, 1e-5) and close(w[4], (ww - lw) * 0.4 / 0.785, 1e-4)
                   and close(w[5], 0.02, 1e-5) and close(w[6], 0.4, 1e-5), f"cloth run {name}: {w}")
         cg = {w[0]: w for w in table(out, "group n " + " ".join(f"{c} {c}_s" for c in cols.split()))}
-        sLA, sLB = math.sqrt(2) * 0.01, math.sqrt(2) * 0.02
-        check(close(cg["matA"][4], -0.61, 1e-5) and close(cg["matA"][5], sLA, 1e-4)
-              and close(cg["matB"][4], -0.52, 1e-5) and close(cg["matB"][5], sLB, 1e-4), f"cloth groups: {cg}")
+        sLA, sLB = math.sqrt(2) * 0.0075, math.sqrt(2) * 0.005
+        check(close(cg["matA"][4], -0.6075, 1e-5) and close(cg["matA"][5], sLA, 1e-4)
+              and close(cg["matB"][4], -0.51375, 1e-5) and close(cg["matB"][5], sLB, 1e-4), f"cloth groups: {cg}")
         cd_ = table(out, "a b windward_cp_diff se leeward_cp_diff se pressure_drag_diff se projected_area_diff "
                          "se")[0]
-        check(close(cd_[2], 0.0, 1e-6) and close(cd_[4], 0.09, 1e-5) and close(cd_[8], 0.0, 1e-6)
+        check(close(cd_[2], 0.0, 1e-6) and close(cd_[4], 0.09375, 1e-5) and close(cd_[8], 0.0, 1e-6)
               and close(cd_[5], math.sqrt(sLA**2 / 2 + sLB**2 / 2), 1e-4), f"cloth difference: {cd_}")
+        lfit = {w[0]: w for w in table(out, "leeward_cp group runs c_at_zero_tilt se")}
+        check(close(lfit["matA"][2], -0.62, 1e-4) and close(lfit["matB"][2], -0.52, 1e-4), f"leeward fit: {lfit}")
+        ldiff = table(out, "leeward_cp a b diff se")[0]
+        check(close(ldiff[2], 0.10, 1e-4), f"leeward fit difference: {ldiff}")
+        lk = [line for line in out.splitlines() if line.startswith("# attitude fit leeward_cp")]
+        check(bool(lk) and "k = 5.000e-05" in lk[0], f"leeward slope: {lk}")
+        wdiff = table(out, "windward_cp a b diff se")[0]
+        check(close(wdiff[2], 0.0, 1e-6), f"windward fit difference: {wdiff}")
         os.remove(os.path.join(dirs[3], "cloth_pressure.csv"))
         r = subprocess.run([PYTHON, script, *dirs, "--window", "3", "8"], capture_output=True, text=True)
         check(r.returncode == 0 and "not every run has a cloth_pressure.csv" in r.stdout,

@@ -30,6 +30,10 @@
 // Δp = K ½ρ u_n|u_n| (Ergun with α = 0, β t = K ρ / 2), u_n the through-velocity normal to
 // the cloth. Then `through_fraction=` is also printed: the mean through-velocity over the
 // body (the coupling's through-flow / its area) over U, averaged like the drag.
+// With the embedded coupling `windward_cp=` and `leeward_cp=` are also printed: the body's
+// wall pressures on its upstream and downstream sides along the stream (coupling::
+// cloth_sides, gauge over ½ρU², averaged like the drag); their difference times the blocked
+// area over πR² is the drag coefficient.
 //
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of
@@ -302,7 +306,8 @@ int main(int argc, char** argv) {
         examples::csv_writer csv(out, "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w");
         std::vector<double> ts, pv, pw;  // the second half, for the probe's spectrum
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
-        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0, blocked_area = 0;
+        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0, blocked_area = 0, sum_w = 0, sum_l = 0;
+        constexpr bool sides = requires { s.coupling().cloth_sides(Eigen::Vector3d::UnitX()); };
         examples::step_guard guard("bluff_body_drag", t_end);
         while (s.time() < t_end * (1.0 - 1e-12)) {
           double dt = guard(s.stable_dt(co.cfl), s.time());
@@ -346,6 +351,11 @@ int main(int argc, char** argv) {
             sum_t += w;
             if constexpr (decltype(cpl)::porosity_type::permeable)
               sum_q += s.coupling().total_through_flow() / s.coupling().coupled_area() / U * w;
+            if constexpr (sides) {  // the body's two sides along the stream (+x), gauge over q
+              const auto cs = s.coupling().cloth_sides(Eigen::Vector3d::UnitX());
+              sum_w += (cs.windward_pressure - p0) / (0.5 * rho * U * U) * w;
+              sum_l += (cs.leeward_pressure - p0) / (0.5 * rho * U * U) * w;
+            }
           }
           prog(s.time(), s.steps());
         }
@@ -358,6 +368,9 @@ int main(int argc, char** argv) {
             cd, shape.c_str(), coupling.c_str(), cells, t_avg, s.time(), s.steps(), max_pen, prog.elapsed());
         if constexpr (decltype(cpl)::porosity_type::permeable)
           std::printf(" through_fraction=%.6g", sum_t > 0 ? sum_q / sum_t : 0.0);
+        if constexpr (sides)
+          std::printf(" windward_cp=%.6g leeward_cp=%.6g", sum_t > 0 ? sum_w / sum_t : 0.0,
+                      sum_t > 0 ? sum_l / sum_t : 0.0);
         if (blocked_area > 0)
           std::printf(" blocked_area_ratio=%.6g drag_coefficient_on_blocked_area=%.6g", blocked_area / area,
                       cd * area / blocked_area);

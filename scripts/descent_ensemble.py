@@ -125,12 +125,17 @@ def cloth_means(run_dir, lo, hi):
     missing = [c for c in ("t",) + CLOTH if c not in (a.dtype.names or ())]
     if missing:
         sys.exit(f"descent_ensemble: {path}: no column {', '.join(missing)}")
-    m = (a["t"] >= lo) & (a["t"] <= hi)
-    if m.sum() < 2:
-        sys.exit(f"descent_ensemble: {path} holds fewer than two rows in the window [{lo}, {hi}] s")
-    vals = [a[c][m] for c in CLOTH]
+    t = np.atleast_1d(a["t"])
+    m = (t >= lo) & (t <= hi)
+    step = np.median(np.diff(t)) if len(t) > 1 else np.inf
+    if m.sum() < 2 or t[m][0] > lo + step or t[m][-1] < hi - step:
+        # e.g. a restart into another directory: the file starts at the checkpoint
+        print(f"# {path} does not cover the window [{lo}, {hi}] s: the run's cloth sides are left out")
+        return None
+    vals = [np.atleast_1d(a[c])[m] for c in CLOTH]
     if not all(np.isfinite(v).all() for v in vals):
-        sys.exit(f"descent_ensemble: {path}: a value in the window [{lo}, {hi}] s is not finite")
+        print(f"# {path}: a value in the window [{lo}, {hi}] s is not finite: the run's cloth sides are left out")
+        return None
     return [v.mean() for v in vals]
 
 
@@ -215,8 +220,10 @@ def main():
         rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter, cloth_means(run_dir, lo, hi)))
         sw = windows(a, lo, hi, o.sub)
         points += [(g, th, c) for th, c, _ in sw]
-        cw = cloth_windows(run_dir, lo, hi, o.sub)
+        cw = cloth_windows(run_dir, lo, hi, o.sub) if rows[-1][7] is not None else None
         if cw is None or len(cw) != len(sw):
+            if side_points:
+                print(f"# the attitude fits of the cloth's sides are left out: {run_dir} has no matching cloth file")
             side_points = None
         elif side_points is not None:
             side_points += [(g, th, w, le) for (th, _, _), (w, le) in zip(sw, cw)]

@@ -691,8 +691,9 @@ class drop_run {
   /// windward_cp and leeward_cp = (p − p∞)/q, pressure_drag_coefficient = (p_w − p_l) S/(q S0)
   /// (the cloth's pressure load along the stream on S0 = π D0²/4; in steady descent the
   /// history's drag_coefficient less the payload's and the lines' drag and the swept terms),
-  /// through_fraction = Q/(|V| S). The two pressures are nan before the first step (no faces
-  /// yet), the four coefficients also while the payload is at rest.
+  /// through_fraction = Q/(|V| S). The two pressures and the four coefficients are nan while
+  /// no face is seen along e (S = 0: before the first step), the coefficients also while the
+  /// payload is at rest.
   void record_cloth(const io::drop_history_row& r) {
     if constexpr (cloth_sides) {
       if (!cloth_csv_) return;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 #include <parafsi/scene/drop.hpp>
@@ -194,13 +195,8 @@ TEST_CASE("drop: cloth_pressure.csv, the loaded canopy's two sides, on the box a
     std::vector<std::vector<double>> rows;
     while (std::getline(in, line)) {
       std::vector<double> v;
-      std::size_t a = 0;
-      while (a <= line.size()) {
-        const std::size_t b = std::min(line.find(',', a), line.size());
-        const std::string cell = line.substr(a, b - a);
-        v.push_back(cell == "nan" ? std::nan("") : std::stod(cell));
-        a = b + 1;
-      }
+      std::stringstream ls(line);
+      for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));  // "nan" reads as NaN
       REQUIRE(v.size() == 9);
       rows.push_back(v);
     }

@@ -379,9 +379,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     {  // the wall pressures p*_K = F_K.m·n − F_K.ρ u_m (the star states move at u_m along n;
        // n from the exchange's box axes: a block mesh replays a face with patch, stage and area only)
       const Eigen::Vector3d n = face_R_.col(fr.axis);
-      double w = 0;
-      for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
-      const double um = w / double(fr.n) + up, b = beta_[std::size_t(stage)] / beta_sum_;
+      const double um = membrane_normal_velocity(fr) + up, b = beta_[std::size_t(stage)] / beta_sum_;
       auto& p = side_p_[fi];
       const double psL = mL.dot(n) - lo.rho * um, psR = mR.dot(n) - hi.rho * um;
       p[0] += b * psL;
@@ -781,6 +779,13 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   }
 
  private:
+  /// The membrane's normal velocity w at a face's crossing, the mean over its layers.
+  double membrane_normal_velocity(const face_rec& fr) const noexcept {
+    double w = 0;
+    for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
+    return w / double(fr.n);
+  }
+
   /// The membrane flux of patched face fc.patch at stage fc.stage; returns u_p.
   double face_flux(const fluid::face_context& fc, const fluid::view& v, fluid::cons<double>& lo,
                    fluid::cons<double>& hi) const {
@@ -793,9 +798,7 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
             " does not match the face list of the last exchange");
     const Eigen::Vector3d n(fc.n.x, fc.n.y, fc.n.z);
     // Membrane normal velocity at the crossing (mean over the layers).
-    double w = 0;
-    for (int q = 0; q < fr.n; ++q) w += crossings_[std::size_t(fr.first + q)].wn;
-    w /= double(fr.n);
+    const double w = membrane_normal_velocity(fr);
     // The face states on each side: one-sided reconstructed (OneSided), else the cells' own
     // (first order: the sweeps' face values would carry slopes read across the membrane).
     double rL, pL, rR, pR;

@@ -689,8 +689,9 @@ class drop_run {
   /// flat pattern's +z: out of the canopy, from its mouth side to its crown side, as the
   /// fabric law gives it at each face's wall pressure jump); with q = ½ ρ∞ |V|²,
   /// windward_cp and leeward_cp = (p − p∞)/q, pressure_drag_coefficient = (p_w − p_l) S/(q S0)
-  /// (the cloth's pressure load along the stream on S0 = π D0²/4; in steady descent the
-  /// history's drag_coefficient less the payload's and the lines' drag and the swept terms),
+  /// (the cloth's pressure load along the stream on S0 = π D0²/4; in a steady descent without
+  /// swing about the history's drag_coefficient, the rest the swept terms; in a swing about
+  /// cos θ of it, the load leaving the payload's path: validation §3.5),
   /// through_fraction = Q/(|V| S). The two pressures and the four coefficients are nan while
   /// no face is seen along e (S = 0: before the first step), the coefficients also while the
   /// payload is at rest.
@@ -700,7 +701,7 @@ class drop_run {
       const Eigen::Vector3d V = structure::payload(s_.structure()).body().mass_centre_velocity();
       const double v = V.norm();
       const Eigen::Vector3d e = v > 0 ? Eigen::Vector3d(-V / v) : Eigen::Vector3d(s_.fluid().pose().R.col(2));
-      const auto cs = s_.coupling().cloth_sides(e.normalized());
+      const auto cs = s_.coupling().cloth_sides(e);
       const double q_inf = pgs_.scaled_ambient(su_.params.air_pressure);
       const double pw = cs.windward_pressure - q_inf, pl = cs.leeward_pressure - q_inf;
       const double q = 0.5 * su_.params.air_density * v * v, nan = std::numeric_limits<double>::quiet_NaN();

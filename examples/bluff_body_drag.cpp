@@ -14,16 +14,16 @@
 // its rim in x = 0 and its pole at x = +R, the concave side facing the oncoming air).
 // Rectilinear grid with cells of D/N (N = --cells) in the box [−0.5D, 1.5D] × [−0.75D,
 // 0.75D]², stretched by 15 % per cell out to [−2.5D, 5D] × [−2.5D, 2.5D]² (blockage πD²/4
-// over 25D² = 3.1 %) by default: `--core-length`, `--core-width` (core) and `--domain-length`,
-// `--domain-width` (box), in diameters behind the body and from the axis, and `--stretch` (the
-// growth) change it (coupling.md §8.1); characteristic far field on all six faces with a 4-cell sponge towards
-// the free stream; impulsive start from the uniform stream. HLLC-LM flux, MUSCL van
-// Leer, SSP-RK2 (for inviscid air `--flux hllc` drops the low-Mach fix and `--limiter
-// minmod` takes the more diffusive limiter: the scheme's dissipation in the wake, §8.2).
-// Inviscid by default (separation fixed by the sharp edge); --reynolds RE
-// switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer
-// on the body is not resolved by either coupling).
-// The penalty coupling uses PFAC = 1 (as the other examples).
+// over 25D² = 3.1 %) by default: `--core-length`, `--core-width` (core) and `--domain-upstream`,
+// `--domain-length`, `--domain-width` (box), in diameters ahead of and behind the body and from
+// the axis, and `--stretch` (the growth) change it (coupling.md §8.1, §8.3); characteristic far
+// field on all six faces with a 4-cell sponge towards the free stream (`--no-sponge`: none);
+// impulsive start from the uniform stream. `--membrane-reconstruction one_sided` reconstructs
+// the cells beside the body from their own side (the drop's default; first order by default here). HLLC-LM flux, MUSCL
+// van Leer, SSP-RK2 (for inviscid air `--flux hllc` drops the low-Mach fix and `--limiter minmod` takes the more
+// diffusive limiter: the scheme's dissipation in the wake, §8.2). Inviscid by default (separation fixed by the sharp
+// edge); --reynolds RE switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer on the body
+// is not resolved by either coupling). The penalty coupling uses PFAC = 1 (as the other examples).
 //
 // Porous bodies: `--fabric mat544|mat59225|mat509` gives the body that fabric's Ergun law
 // (the paper's Table 2), `--porous-resistance K` the quadratic loss law of a screen,
@@ -34,6 +34,15 @@
 // wall pressures on its upstream and downstream sides along the stream (coupling::
 // cloth_sides, gauge over ½ρU², averaged like the drag); their difference times the blocked
 // area over πR² is the drag coefficient.
+//
+// `upstream_total_cp=` is the stream's total pressure one diameter ahead of the body on the
+// axis, (p − p∞)/½ρU² + |u|²/U², averaged like the drag: 1 (to M²/4) in an unbounded stream.
+// Above 1 the box feeds the body a stream with more than the free stream's total pressure: at
+// low Mach number the characteristic far field holds the inflow's velocity (its ρc impedance
+// lets a steady pressure rise move the velocity by only δp/ρc) and the sponge pulls the state
+// back to the free stream, so the body's blockage pressure near an inflow face that is close
+// becomes an excess of total pressure on the body's front (coupling.md §8.3: 1.19 with the
+// default box at 8 cells per diameter and 40 m/s, 1.01 from 6 D upstream and ±5 D).
 //
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of
@@ -87,10 +96,11 @@ namespace {
 /// The block mesh's layout (see the file comment): blocks of n³ cells, the finest cell h
 /// on level L, L the largest that leaves at least two root blocks (n 2^L h) across the
 /// box's narrowest side; root faces on x = −0.5 D and on the axis, the box grown to whole
-/// root blocks: upstream to at least −2.5 D, downstream to `length` D, laterally to
+/// root blocks: upstream to at least −`upstream` D, downstream to `length` D, laterally to
 /// ±`width` D. Returns the layout and L.
-std::pair<pf::fluid::block_layout, int> core_blocks(double D, double h, int n, double length, double width) {
-  const double narrow = std::min(2.0 * width * D, (2.5 + length) * D);
+std::pair<pf::fluid::block_layout, int> core_blocks(double D, double h, int n, double length, double width,
+                                                    double upstream) {
+  const double narrow = std::min(2.0 * width * D, (upstream + length) * D);
   const int L = std::max(0, int(std::floor(std::log2(narrow / (2.0 * n * h) + 1e-9))));
   if (L > pf::fluid::blocks::tree::max_depth)
     throw std::invalid_argument("bluff_body_drag: " + std::to_string(L) + " levels are too many (fewer --cells)");
@@ -98,7 +108,8 @@ std::pair<pf::fluid::block_layout, int> core_blocks(double D, double h, int n, d
   const auto whole = [&](double span) { return pf::index_t(std::ceil(span / root - 1e-9)); };
   pf::fluid::block_layout lay;
   lay.block_cells = n;
-  const pf::index_t up = whole(2.0 * D), down = whole((length + 0.5) * D), side = whole(width * D);
+  const pf::index_t up = whole(std::max(upstream - 0.5, 0.5) * D), down = whole((length + 0.5) * D),
+                    side = whole(width * D);
   lay.lo = {-0.5 * D - double(up) * root, -double(side) * root, -double(side) * root};
   lay.hi = {-0.5 * D + double(down) * root, double(side) * root, double(side) * root};
   lay.root_blocks = {up + down, 2 * side, 2 * side};
@@ -115,11 +126,14 @@ int main(int argc, char** argv) {
   CLI::App app{"Drag of a fixed disk or hemispherical cup in a uniform stream (penalty or embedded coupling)"};
   examples::common_options co;
   std::string shape = "disk", coupling = "embedded", out, fabric = "none", closure = "none", mesh = "tensor";
+  std::string membrane_reconstruction = "first_order";
   int block_size = 8;
   double U = 40.0, Re = 0.0, pfac = 1.0, t_end = -1.0, flow_times = 16.0, resistance = 0.0, kick = 0.0;
   // The grid, in diameters: uniform cells of D/N in [-0.5, core_length] x [-core_width, core_width]^2,
-  // stretched out to [-2.5, domain_length] x [-domain_width, domain_width]^2.
-  double core_length = 1.5, core_width = 0.75, domain_length = 5.0, domain_width = 2.5, stretch = 1.15;
+  // stretched out to [-domain_upstream, domain_length] x [-domain_width, domain_width]^2.
+  double core_length = 1.5, core_width = 0.75, domain_length = 5.0, domain_width = 2.5, stretch = 1.15,
+         domain_upstream = 2.5;
+  bool no_sponge = false;
   int cells = 8;
   examples::add_run_options(app, co);
   app.add_option("--shape", shape, "disk (flat, normal to the stream) or cup (hemisphere, open towards the stream)")
@@ -128,6 +142,11 @@ int main(int argc, char** argv) {
   app.add_option("--coupling", coupling,
                  "coupling method: penalty (the paper's) or embedded (membrane-aware face fluxes)")
       ->check(CLI::IsMember({"penalty", "embedded"}))
+      ->capture_default_str();
+  app.add_option("--membrane-reconstruction", membrane_reconstruction,
+                 "embedded: the cells beside the body reconstructed from their own side (one_sided, second order up "
+                 "to the wall) or first order")
+      ->check(CLI::IsMember({"first_order", "one_sided"}))
       ->capture_default_str();
   examples::add_cells_option(app, cells, "fluid cells across the body diameter D = 0.2 m", 4);
   app.add_option("--velocity", U, "free-stream velocity U (m/s)")->check(CLI::Range(1.0, 100.0))->capture_default_str();
@@ -171,6 +190,12 @@ int main(int argc, char** argv) {
   app.add_option("--domain-width", domain_width, "half-width of the box (diameters from the axis)")
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str();
+  app.add_option("--domain-upstream", domain_upstream,
+                 "upstream end of the box (diameters ahead of the body; the far field there holds the inflow)")
+      ->check(CLI::Range(1.0, 200.0))
+      ->capture_default_str();
+  app.add_flag("--no-sponge", no_sponge,
+               "no sponge layer inside the far-field faces (the characteristic far field alone)");
   app.add_option("--stretch", stretch, "growth of the cells outside the core, per cell")
       ->check(CLI::Range(1.0, 1.5))
       ->capture_default_str();
@@ -209,20 +234,21 @@ int main(int argc, char** argv) {
     // The stretched part is empty or at least one core cell wide (no sliver cell that would
     // cut the time step).
     const auto gap_ok = [&](double core, double box) { return core == box || (box - core) * cells >= 1.0 - 1e-9; };
-    if (!gap_ok(core_length, domain_length) || !gap_ok(core_width, domain_width))
-      throw std::invalid_argument("bluff_body_drag: the core (--core-length " + std::to_string(core_length) +
-                                  ", --core-width " + std::to_string(core_width) +
-                                  ") must end at the box (--domain-length, --domain-width) or at least one cell "
-                                  "(1/" +
-                                  std::to_string(cells) + " D) inside it");
+    if (!gap_ok(core_length, domain_length) || !gap_ok(core_width, domain_width) || !gap_ok(0.5, domain_upstream))
+      throw std::invalid_argument(
+          "bluff_body_drag: the core (--core-length " + std::to_string(core_length) + ", --core-width " +
+          std::to_string(core_width) +
+          ") must end at the box (--domain-length, --domain-width, --domain-upstream from 0.5) or at least one cell "
+          "(1/" +
+          std::to_string(cells) + " D) inside it");
     using pf::fluid::axis;
     const auto lateral = axis::refined(-domain_width * D, domain_width * D, -core_width * D, core_width * D, h,
                                        stretch);
-    auto grid = pf::fluid::rectilinear_grid{axis::refined(-2.5 * D, domain_length * D, -0.5 * D, core_length * D, h,
-                                                          stretch),
+    auto grid = pf::fluid::rectilinear_grid{axis::refined(-domain_upstream * D, domain_length * D, -0.5 * D,
+                                                          core_length * D, h, stretch),
                                             lateral, lateral};
     pf::boundary::set bc = pf::boundary::set::all(pf::boundary::far_field{rho, {U, 0, 0}, p0});
-    bc.layer.cells = 4;
+    bc.layer.cells = no_sponge ? 0 : 4;
     if (grid.interior_cells() > 200'000'000)
       throw std::invalid_argument("bluff_body_drag: the grid has " + std::to_string(grid.interior_cells()) +
                                   " cells, more than 2e8 (fewer --cells, a smaller box or more --stretch)");
@@ -252,24 +278,28 @@ int main(int argc, char** argv) {
           "bluff_body_drag: --flux and --limiter other than hllc_lm and van_leer need "
           "inviscid air (no --reynolds, --closure none)");
     if (!co.quiet)
-      std::fprintf(stderr,
-                   "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, %s grid %lld x %lld x %lld = "
-                   "%lld cells (core to %g D behind, +-%g D; box to %g D, +-%g D, blockage %.2g %%), %zu triangles, "
-                   "t_end = %g s (%g D/U), %s\n",
-                   shape.c_str(), coupling.c_str(), D, U, cells,
-                   mesh == "tensor" ? "mesh: tensor" : "(the tensor mesh's)", (long long)grid.n(0),
-                   (long long)grid.n(1), (long long)grid.n(2), (long long)grid.interior_cells(), core_length,
-                   core_width, domain_length, domain_width,
-                   100.0 * std::numbers::pi / 16.0 / (domain_width * domain_width), dm.triangles.size(), t_end,
-                   t_end * U / D,
-                   mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str() : "inviscid");
+      std::fprintf(
+          stderr,
+          "bluff_body_drag: %s, %s coupling, D = %g m, U = %g m/s, h = D/%d, %s grid %lld x %lld x %lld = "
+          "%lld cells (core to %g D behind, +-%g D; box from %g D ahead to %g D behind, +-%g D, blockage %.2g %%%s), "
+          "%zu triangles, "
+          "t_end = %g s (%g D/U), %s\n",
+          shape.c_str(), coupling.c_str(), D, U, cells, mesh == "tensor" ? "mesh: tensor" : "(the tensor mesh's)",
+          (long long)grid.n(0), (long long)grid.n(1), (long long)grid.n(2), (long long)grid.interior_cells(),
+          core_length, core_width, domain_upstream, domain_length, domain_width,
+          100.0 * std::numbers::pi / 16.0 / (domain_width * domain_width), no_sponge ? ", no sponge" : "",
+          dm.triangles.size(), t_end, t_end * U / D,
+          mu > 0 ? ("Re = " + std::to_string(rho * U * D / mu) + ", closure " + closure).c_str() : "inviscid");
 
     // Wake probe: the cell holding (2D, 0, 0).
     const Eigen::Vector3d probe_point(2 * D, 0.0, 0.0);
-    std::array<pf::index_t, 3> probe{};
+    // Upstream probe: the cell holding (−D, 0, 0), the stream's total pressure one diameter ahead.
+    const Eigen::Vector3d ahead_point(-D, 0.0, 0.0);
+    std::array<pf::index_t, 3> probe{}, ahead{};
     for (int d = 0; d < 3; ++d) {
       const auto& f = grid.axis_of(d).faces;
       probe[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), probe_point[d]) - f.begin()) - 1;
+      ahead[std::size_t(d)] = pf::index_t(std::upper_bound(f.begin(), f.end(), ahead_point[d]) - f.begin()) - 1;
     }
     if (mesh == "tensor" && probe[0] >= grid.n(0) - bc.layer.cells)
       throw std::invalid_argument("bluff_body_drag: the wake probe at 2 D lies in the far-field sponge (the last " +
@@ -306,7 +336,7 @@ int main(int argc, char** argv) {
         examples::csv_writer csv(out, "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w");
         std::vector<double> ts, pv, pw;  // the second half, for the probe's spectrum
         examples::progress prog("bluff_body_drag", t_end, co.quiet);
-        double sum = 0, sum_t = 0, max_pen = 0, sum_q = 0, blocked_area = 0, sum_w = 0, sum_l = 0;
+        double sum = 0, sum_t = 0, sum_p0 = 0, max_pen = 0, sum_q = 0, blocked_area = 0, sum_w = 0, sum_l = 0;
         constexpr bool sides = requires { s.coupling().cloth_sides(Eigen::Vector3d::UnitX()); };
         examples::step_guard guard("bluff_body_drag", t_end);
         while (s.time() < t_end * (1.0 - 1e-12)) {
@@ -335,9 +365,11 @@ int main(int argc, char** argv) {
           const Eigen::Vector3d c = s.coupling().diagnostics().impulse_structure / dt / qA;
           const double cd = c.x();
           if (!c.allFinite()) throw pf::numerical_failure("bluff_body_drag: the body force is not finite", 0, s.time());
-          pf::fluid::prim<double> wp;
-          if constexpr (blocks) wp = s.fluid().sample(probe_point);
-          else wp = s.fluid().primitive(probe[0], probe[1], probe[2]);
+          pf::fluid::prim<double> wp, wa;
+          if constexpr (blocks) wp = s.fluid().sample(probe_point), wa = s.fluid().sample(ahead_point);
+          else
+            wp = s.fluid().primitive(probe[0], probe[1], probe[2]),
+            wa = s.fluid().primitive(ahead[0], ahead[1], ahead[2]);
           csv.row({s.time(), cd, c.y(), c.z(), wp.u.y / U, wp.u.z / U});
           if (s.time() > t_avg) {
             ts.push_back(s.time());
@@ -349,6 +381,7 @@ int main(int argc, char** argv) {
           if (w > 0) {
             sum += cd * w;
             sum_t += w;
+            sum_p0 += ((wa.p - p0) / (0.5 * rho * U * U) + pf::dot(wa.u, wa.u) / (U * U)) * w;
             if constexpr (decltype(cpl)::porosity_type::permeable)
               sum_q += s.coupling().total_through_flow() / s.coupling().coupled_area() / U * w;
             if constexpr (sides) {  // the body's two sides along the stream (+x), gauge over q
@@ -371,6 +404,15 @@ int main(int argc, char** argv) {
         if constexpr (sides)
           std::printf(" windward_cp=%.6g leeward_cp=%.6g", sum_t > 0 ? sum_w / sum_t : 0.0,
                       sum_t > 0 ? sum_l / sum_t : 0.0);
+        const double cp0 = sum_t > 0 ? sum_p0 / sum_t : 1.0;
+        std::printf(" upstream_total_cp=%.6g", cp0);
+        if (cp0 > 1.03 && t_avg * U / D >= 2.0)  // past the impulsive start's acoustic transient
+          std::fprintf(stderr,
+                       "bluff_body_drag: warning: the stream one diameter ahead of the body carries %.3g q of total "
+                       "pressure, %.0f %% of q more than the free stream: the box's inflow is too close or too narrow "
+                       "for this body and the drag carries about that excess (coupling.md 8.3; try --domain-upstream 6 "
+                       "--domain-width 5)\n",
+                       cp0, 100.0 * (cp0 - 1.0));
         if (blocked_area > 0)
           std::printf(" blocked_area_ratio=%.6g drag_coefficient_on_blocked_area=%.6g", blocked_area / area,
                       cd * area / blocked_area);
@@ -381,12 +423,16 @@ int main(int argc, char** argv) {
           else std::printf(" strouhal=none");
           std::printf(" probe_amplitude=%.3g shedding_periods=%.3g", pk.amplitude, pk.periods);
         }
-        std::printf(" closure=%s reynolds=%.4g mesh=%s flux=%s limiter=%s\n", closure.c_str(),
-                    mu > 0 ? rho * U * D / mu : 0.0, mesh.c_str(), Fluid::flux_type::name(), Fluid::recon_type::name());
+        std::printf(" closure=%s reynolds=%.4g mesh=%s flux=%s limiter=%s membrane_reconstruction=%s\n",
+                    closure.c_str(), mu > 0 ? rho * U * D / mu : 0.0, mesh.c_str(), Fluid::flux_type::name(),
+                    Fluid::recon_type::name(), coupling == "embedded" ? membrane_reconstruction.c_str() : "none");
         return 0;
       };
       auto with = [&](auto por) -> int {
-        if (coupling == "embedded") return run(pf::coupling::embedded{por});
+        if (coupling == "embedded") {
+          if (membrane_reconstruction == "one_sided") return run(pf::coupling::embedded<decltype(por), true>{por});
+          return run(pf::coupling::embedded{por});
+        }
         pf::coupling::penalty_options po;
         po.pfac = pfac;
         return run(pf::coupling::penalty{por, po});
@@ -404,11 +450,11 @@ int main(int argc, char** argv) {
     // The fluid on the chosen mesh with the given policies (flux and reconstruction first).
     auto with_fluid = [&](auto... policies) -> int {
       if (mesh == "tensor") return run_with(pf::fluid::solver{grid, bc, policies...});
-      const auto [lay, levels] = core_blocks(D, h, block_size, domain_length, domain_width);
+      const auto [lay, levels] = core_blocks(D, h, block_size, domain_length, domain_width, domain_upstream);
       // The block mesh's sponge is counted in root cells (a width that varies with N and the
       // block size): as many as make it closest to 1.2 D (the tensor grid's 4 outer cells, default box: 0.95-1.34 D).
       auto bcb = bc;
-      bcb.layer.cells = std::max(1, int(std::lround(1.2 * D / lay.cell_width(0, 0))));
+      bcb.layer.cells = no_sponge ? 0 : std::max(1, int(std::lround(1.2 * D / lay.cell_width(0, 0))));
       pf::fluid::block_solver fl{pf::fluid::blocks::tree(lay.root_blocks), lay, bcb, policies...};
       fl.regrid(pf::fluid::blocks::in_box{lay,
                                           {-0.5 * D, -core_width * D, -core_width * D},

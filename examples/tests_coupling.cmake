@@ -112,6 +112,16 @@ if(TARGET bluff_body_drag)
   parafsi_coupling_example(example_coupling_bluff_disk_box bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ " --shape disk --cells 4 --time 0.002 --core-length 3 --core-width 1 --domain-length 8
     --domain-width 3 --stretch 1.2 --quiet)
+  # The inflow further upstream, no sponge, one-sided cells beside the body: the stream's total
+  # pressure ahead and the reconstruction are printed.
+  parafsi_coupling_example(example_coupling_bluff_disk_upstream bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
+    "drag_coefficient=[0-9.e+-]+ .* upstream_total_cp=[0-9.e+-]+ .* membrane_reconstruction=one_sided" --shape disk
+    --cells 4 --time 0.002 --domain-upstream 6 --no-sponge --membrane-reconstruction one_sided --quiet)
+  parafsi_coupling_example(example_coupling_bluff_disk_blocks_upstream bluff_body_drag
+    "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w" "drag_coefficient=[0-9.e+-]+ .* upstream_total_cp="
+    --shape disk --mesh blocks --cells 8 --time 0.0005 --domain-upstream 6 --quiet)
+  parafsi_coupling_example_fails(example_coupling_bluff_upstream_too_short bluff_body_drag --domain-upstream 0.5
+    --out ${_cpl_out}/unused.csv)
   # The block mesh (the finest level on the core, 2:1 rings outside), with a closure's wall distance on blocks.
   parafsi_coupling_example(example_coupling_bluff_disk_blocks bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ .* blocked_area_ratio=1.03451 " --shape disk --mesh blocks --cells 8 --time 0.0005 --quiet)

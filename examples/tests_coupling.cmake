@@ -122,6 +122,12 @@ if(TARGET bluff_body_drag)
     --shape disk --mesh blocks --cells 8 --time 0.0005 --domain-upstream 6 --quiet)
   parafsi_coupling_example_fails(example_coupling_bluff_upstream_too_short bluff_body_drag --domain-upstream 0.5
     --out ${_cpl_out}/unused.csv)
+  parafsi_example_refuses(example_coupling_bluff_sponge_upstream bluff_body_drag ""
+    "the far-field sponge .* reaches the air just upstream of the body" --cells 4 --domain-upstream 1
+    --out ${_cpl_out}/unused.csv)
+  parafsi_example_refuses(example_coupling_bluff_one_sided_penalty bluff_body_drag ""
+    "--membrane-reconstruction one_sided needs --coupling embedded" --coupling penalty
+    --membrane-reconstruction one_sided --out ${_cpl_out}/unused.csv)
   # The block mesh (the finest level on the core, 2:1 rings outside), with a closure's wall distance on blocks.
   parafsi_coupling_example(example_coupling_bluff_disk_blocks bluff_body_drag "t,drag_coefficient,side_force_y,side_force_z,probe_v,probe_w"
     "drag_coefficient=[0-9.e+-]+ .* blocked_area_ratio=1.03451 " --shape disk --mesh blocks --cells 8 --time 0.0005 --quiet)

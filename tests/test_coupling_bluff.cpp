@@ -127,7 +127,7 @@ TEST_CASE(
   CHECK(cd < 1.15 * 1.17);
   // The wall pressures carry the whole load, every step, to round-off; the front is loaded
   // and the back in suction. The front reads C_p 1.16 on p∞, above the free stream's
-  // stagnation value 1 + M²/4 = 1.004: this box feeds the disk a stream of more total
+  // stagnation value 1 + M²/4 = 1.003: this box feeds the disk a stream of more total
   // pressure (the next test case; coupling.md §8.3).
   CHECK(r.load_identity < 1e-9);
   CHECK(r.windward_cp > 0.5);
@@ -136,23 +136,22 @@ TEST_CASE(
 
 TEST_CASE("bluff body: the stream ahead of the disk keeps the free stream's total pressure once the inflow is far") {
   // Bernoulli on the stagnation streamline: one diameter ahead of the disk the total pressure
-  // is the free stream's, C_p + |u|²/U² = 1 + O(M²/4 = 0.0034), whatever the disk does to the
+  // is the free stream's, C_p + |u|²/U² = 1 + O(M²/4 = 0.0033), whatever the disk does to the
   // velocity there. At low Mach number the characteristic far field holds the inflow's velocity
   // (a steady pressure rise δp moves it by δp/ρc only) and the sponge pulls the state back to
   // the free stream, so an inflow face close to the body turns the body's blockage pressure
   // into an excess of total pressure. Measured (8 cells per diameter, 16 D/U): 1.19 from 2.5 D
-  // upstream and ±2.5 D, 1.013 from 6 D and ±5 D (coupling.md §8.3). 6 cells per diameter, 4 D/U
-  // (the excess settles within 2 D/U).
+  // upstream and ±2.5 D, 1.013 from 6 D and ±5 D (coupling.md §8.3). 6 cells per diameter, 4 D/U:
+  // with the far inflow the value holds from 2 D/U on (1.005 over 8–16 D/U); with the near one
+  // the excess keeps growing with the wake (1.096 over 2–4 D/U, 1.128 over 8–16).
   const auto near = disk_drag(6, 4.0, pf::coupling::embedded{pf::porosity::impermeable{}});
   const auto far = disk_drag(6, 4.0, pf::coupling::embedded{pf::porosity::impermeable{}}, {6.0, 5.0});
   MESSAGE("total pressure one diameter ahead, (p - p_inf)/q + |u|^2/U^2 over 2-4 D/U: inflow at 2.5 D, +-2.5 D: "
           << near.upstream_total_cp << "; at 6 D, +-5 D: " << far.upstream_total_cp << " (C_d " << near.cd << ", "
           << far.cd << "; windward C_p " << near.windward_cp << ", " << far.windward_cp << ")");
   CHECK(std::fabs(far.upstream_total_cp - 1.0) < 0.025);
-  // The excess is the near inflow's: it falls with the distance to it.
-  CHECK(near.upstream_total_cp - 1.0 > 3.0 * std::fabs(far.upstream_total_cp - 1.0));
-  // On p∞ the front's wall pressure carries the excess: it falls with it (1.136 and 1.038 here).
-  CHECK(near.windward_cp - far.windward_cp > 0.5 * (near.upstream_total_cp - far.upstream_total_cp));
+  // The near inflow's excess and the front's wall pressure on p∞, which carries it, are
+  // reported, not pinned: they measure the box, and a better inflow condition would lower them.
 }
 
 TEST_CASE(

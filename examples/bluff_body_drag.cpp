@@ -45,7 +45,8 @@
 // back to the free stream, so the body's blockage pressure near an inflow face that is close
 // becomes an excess of total pressure on the body's front (coupling.md §8.3: 1.19 with the
 // default box at 8 cells per diameter and 40 m/s, 1.01 from 6 D upstream and ±5 D). The
-// default box is the fast one, kept for the tables measured in it: past 4 D/U its runs warn.
+// default box is the fast one, kept for the tables measured in it: past 4 D/U its runs warn (from 6 cells
+// per diameter: at 4 and 5 the probe lies in the sponge and reads nan).
 //
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of
@@ -311,9 +312,19 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("bluff_body_drag: the far-field sponge (the first " + std::to_string(bc.layer.cells) +
                                   " cells) reaches the air just upstream of the body; lengthen the box "
                                   "(--domain-upstream)");
+    // The sponge across the stream reaching the rim (a narrow box), as the block mesh checks.
+    for (int d = 1; mesh == "tensor" && bc.layer.cells > 0 && d < 3; ++d) {
+      const auto& f = grid.axis_of(d).faces;
+      if (f[std::size_t(bc.layer.cells)] > -0.5 * D || f[f.size() - 1 - std::size_t(bc.layer.cells)] < 0.5 * D)
+        throw std::invalid_argument(
+            "bluff_body_drag: the far-field sponge reaches the body's rim; widen the box (--domain-width)");
+    }
     // The upstream probe inside the sponge (a short box at few cells per diameter) reads the
     // sponge's state, not the stream's: it is then reported as nan.
-    bool ahead_in_sponge = mesh == "tensor" && ahead[0] < bc.layer.cells;
+    bool ahead_in_sponge = false;
+    for (int d = 0; mesh == "tensor" && d < 3; ++d)
+      ahead_in_sponge = ahead_in_sponge || ahead[std::size_t(d)] < bc.layer.cells ||
+                        ahead[std::size_t(d)] >= grid.n(d) - bc.layer.cells;
     if (coupling != "embedded" && membrane_reconstruction != "first_order")
       throw std::invalid_argument("bluff_body_drag: --membrane-reconstruction one_sided needs --coupling embedded");
     auto run_with = [&](auto fl) -> int {

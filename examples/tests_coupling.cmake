@@ -125,6 +125,9 @@ if(TARGET bluff_body_drag)
   parafsi_example_refuses(example_coupling_bluff_sponge_upstream bluff_body_drag ""
     "the far-field sponge .* reaches the air just upstream of the body" --cells 4 --domain-upstream 1
     --out ${_cpl_out}/unused.csv)
+  parafsi_example_refuses(example_coupling_bluff_sponge_rim bluff_body_drag ""
+    "the far-field sponge reaches the body's rim" --cells 8 --domain-width 1 --core-width 0.6
+    --out ${_cpl_out}/unused.csv)
   parafsi_example_refuses(example_coupling_bluff_one_sided_penalty bluff_body_drag ""
     "--membrane-reconstruction one_sided needs --coupling embedded" --coupling penalty
     --membrane-reconstruction one_sided --out ${_cpl_out}/unused.csv)

@@ -29,13 +29,18 @@ namespace st = pf::structure;
 
 namespace {
 constexpr double rho0 = 1.18, p0 = 101325.0, xs = 0.5;
+/// The inclined screens' centre, 0.3 of a cell (of the 40-cell duct) past xs: at xs itself the
+/// 45° cloth passes through cell centres on the diagonals between its triangles, a degenerate
+/// crossing whose face is decided by round-off (16 to 32 faces for 16, and the through-flow
+/// with them); off the centres every x-line crosses it once.
+constexpr double xs_inclined = xs + 0.3 / 40.0;
 
 /// The duct with the pinned screen (E = 0.3 GPa, ν 0.3, 54 g/m², t = 0.11 mm), air at rest
 /// or moving at u0.
 template <class Coupling, class Flux = pf::flux::hllc_lm>
 auto make_duct(Coupling cpl, const pf::boundary::set& bc, int cells, double u0, Flux flux = {},
-               double incline_deg = 0.0, int width_cells = 2) {
-  const auto d = pf::model::duct_screen(1.0, cells, xs, 2, incline_deg, width_cells);
+               double incline_deg = 0.0, int width_cells = 2, double x_sheet = xs) {
+  const auto d = pf::model::duct_screen(1.0, cells, x_sheet, 2, incline_deg, width_cells);
   pf::fluid::solver fl{ctu::duct_grid(d), bc, flux};
   fl.fill_uniform({rho0, {u0, 0, 0}, p0});
   return pf::explicit_stepper{std::move(fl), ctu::pinned_sheet(d), std::move(cpl)};
@@ -206,11 +211,11 @@ TEST_CASE_TEMPLATE_DEFINE(
   for (double deg : {0.0, 30.0, 45.0}) {
     const double th = deg * M_PI / 180.0, reach = 0.1 * std::tan(th);
     const double V = law.through_velocity(100.0) / std::cos(th);  // about 100 Pa across
-    auto s = make_duct(C::make(law, 1.0), duct_bc(V), 40, V, pf::flux::hllc{}, deg, 8);
+    auto s = make_duct(C::make(law, 1.0), duct_bc(V), 40, V, pf::flux::hllc{}, deg, 8, xs_inclined);
     while (s.time() < 0.08) s.step(s.stable_dt(0.5));
     double pu, uu, m, pd, ud;
-    ctu::window_means(s, xs - reach - 0.2, xs - reach - 0.1, pu, uu, m);
-    ctu::window_means(s, xs + reach + 0.1, xs + reach + 0.2, pd, ud, m);
+    ctu::window_means(s, xs_inclined - reach - 0.2, xs_inclined - reach - 0.1, pu, uu, m);
+    ctu::window_means(s, xs_inclined + reach + 0.1, xs_inclined + reach + 0.2, pd, ud, m);
     const double un = uu * std::cos(th), dp = pu - pd, err = dp / law.pressure_jump(un) - 1.0;
     const double un_cpl = s.coupling().total_through_flow() / s.coupling().coupled_area();
     std::printf(
@@ -221,15 +226,13 @@ TEST_CASE_TEMPLATE_DEFINE(
     CHECK(std::fabs(un_cpl / un - 1.0) < 0.05);  // relative (Approx would add its scale of 1)
     if constexpr (requires { s.coupling().cloth_sides(Eigen::Vector3d::UnitX()); }) {
       // The cloth seen along the stream: its projection is the duct's cross-section (every
-      // x-line of cell centres crosses it once; at 45° every line meets it on a cell centre,
-      // on the diagonal between two triangles, and whether the two crossings fall on one face
-      // or on both neighbours is decided by round-off: 16 to 32 faces for 16), its
+      // x-line of cell centres crosses it once, off the cell centres: xs_inclined), its
       // wall pressures give the load the duct's momentum balance puts on it (the probes' dp on
       // the cross-section: slip walls, the same U on both sides), and the air crossing it is
       // the duct's flow U A: exactly when the cloth is normal to the stream, and within the
       // staircase's count of faces when inclined (the y-faces of a cloth 4.6 and 8 cells long
       // in x come in whole faces: Σ c_f A_f = A Σ_d m_d² up to a face).
-      const auto d = pf::model::duct_screen(1.0, 40, xs, 2, deg, 8);
+      const auto d = pf::model::duct_screen(1.0, 40, xs_inclined, 2, deg, 8);
       const auto cs = s.coupling().cloth_sides(Eigen::Vector3d::UnitX());
       const double dp_wall = cs.windward_pressure - cs.leeward_pressure, Q = uu * d.area();
       const double e_area = cs.projected_area / d.area() - 1.0;
@@ -239,17 +242,11 @@ TEST_CASE_TEMPLATE_DEFINE(
           "%.2f), load error %+.3f %%, through-flow %.5f m3/s (U A %.5f, %+.2f %%), %ld faces\n",
           cs.projected_area, d.area(), dp_wall, dp, law.pressure_jump(un), 100 * e_load, cs.through_flow, Q, 100 * e_q,
           long(cs.faces));
-      if (deg == 45.0) {
-        CHECK(e_area > -1e-9);
-        CHECK(e_area < 1.0 + 1e-9);
-        CHECK(std::fabs(e_load) < 3e-3);
-        CHECK(std::fabs(e_q) < 0.10);
-      } else {
-        CHECK(std::fabs(e_area) < 1e-9);
-        CHECK(std::fabs(e_load) < 1e-4);
-        if (deg == 0.0) CHECK(std::fabs(e_q) < 1e-6);
-        if (deg == 30.0) CHECK((e_q < 0 && e_q > -0.05));  // the staircase's y-faces: 8 for 9.2
-      }
+      CHECK(std::fabs(e_area) < 1e-9);
+      CHECK(std::fabs(e_load) < 1e-4);
+      if (deg == 0.0) CHECK(std::fabs(e_q) < 1e-6);
+      if (deg == 30.0) CHECK((e_q < 0 && e_q > -0.05));  // the staircase's y-faces: 8 for 9.2
+      if (deg == 45.0) CHECK((e_q < 0 && e_q > -0.10));  // measured −6.25 %
       // Seen against the stream the sides swap; the flow along the cloth's normal stays.
       const auto back = s.coupling().cloth_sides(-Eigen::Vector3d::UnitX());
       CHECK(back.windward_pressure == cs.leeward_pressure);

@@ -19,11 +19,13 @@
 // the axis, and `--stretch` (the growth) change it (coupling.md §8.1, §8.3); characteristic far
 // field on all six faces with a 4-cell sponge towards the free stream (`--no-sponge`: none);
 // impulsive start from the uniform stream. `--membrane-reconstruction one_sided` reconstructs
-// the cells beside the body from their own side (the drop's default; first order by default here). HLLC-LM flux, MUSCL
-// van Leer, SSP-RK2 (for inviscid air `--flux hllc` drops the low-Mach fix and `--limiter minmod` takes the more
-// diffusive limiter: the scheme's dissipation in the wake, §8.2). Inviscid by default (separation fixed by the sharp
-// edge); --reynolds RE switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary layer on the body
-// is not resolved by either coupling). The penalty coupling uses PFAC = 1 (as the other examples).
+// the cells beside the body from their own side (the drop's default; first order by default
+// here). HLLC-LM flux, MUSCL van Leer, SSP-RK2 (for inviscid air `--flux hllc` drops the
+// low-Mach fix and `--limiter minmod` takes the more diffusive limiter: the scheme's
+// dissipation in the wake, §8.2). Inviscid by default (separation fixed by the sharp edge);
+// --reynolds RE switches on constant viscosity μ = ρUD/RE (laminar; no wall law, the boundary
+// layer on the body is not resolved by either coupling). The penalty coupling uses PFAC = 1
+// (as the other examples).
 //
 // Porous bodies: `--fabric mat544|mat59225|mat509` gives the body that fabric's Ergun law
 // (the paper's Table 2), `--porous-resistance K` the quadratic loss law of a screen,
@@ -45,8 +47,8 @@
 // back to the free stream, so the body's blockage pressure near an inflow face that is close
 // becomes an excess of total pressure on the body's front (coupling.md §8.3: 1.19 with the
 // default box at 8 cells per diameter and 40 m/s, 1.01 from 6 D upstream and ±5 D). The
-// default box is the fast one, kept for the tables measured in it: past 4 D/U its runs warn (from 6 cells
-// per diameter: at 4 and 5 the probe lies in the sponge and reads nan).
+// default box is the fast one, kept for the tables measured in it: past 4 D/U its runs warn
+// (from 6 cells per diameter: at 4 and 5 the probe lies in the sponge and reads nan).
 //
 // The embedded coupling blocks whole grid faces: a face is a wall when the segment between
 // its two cell centres crosses the body, so the body's frontal area is the count of

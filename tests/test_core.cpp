@@ -2,6 +2,8 @@
 // deterministic parallel reductions, policy composition helpers.
 #include <doctest/doctest.h>
 
+#include "approx.hpp"
+
 #include <numeric>
 #include <parafsi/parafsi.hpp>
 
@@ -128,4 +130,17 @@ TEST_CASE("require throws invalid_input with the concatenated message") {
   } catch (const invalid_input& e) {
     CHECK(std::string(e.what()) == "value 3.5 out of range");
   }
+}
+
+TEST_CASE("tests' pft::rel is relative at every size, where doctest::Approx is absolute below 1") {
+  // doctest's scale of 1: 5 % off 0.078 passes "to 2 %", twice 5e-15 passes "to 1e-9".
+  CHECK(0.078 * 1.05 == doctest::Approx(0.078).epsilon(0.02));
+  CHECK(1e-14 == doctest::Approx(5e-15).epsilon(1e-9));
+  CHECK(0.078 * 1.05 != pft::rel(0.078, 0.02));
+  CHECK(0.078 * 1.019 == pft::rel(0.078, 0.02));
+  CHECK(1e-14 != pft::rel(5e-15, 1e-9));
+  CHECK(5e-15 * (1 + 1e-10) == pft::rel(5e-15, 1e-9));
+  CHECK(-3e7 * (1 + 1e-10) == pft::rel(-3e7, 1e-9));
+  CHECK(0.0 == pft::rel(0.0, 1e-12));
+  CHECK(1e-300 != pft::rel(0.0, 1e-12));
 }

@@ -2,6 +2,8 @@
 // with known answers; the history and summary files (io/drop_history.hpp).
 #include <doctest/doctest.h>
 
+#include "approx.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -251,19 +253,19 @@ TEST_CASE("t_mo: the inflation overshoot, not a later, higher breathing peak") {
     h.push_back(r);
   }
   const auto s = io::summarize(h, "breathing");
-  CHECK(s.steady_diameter == Approx(0.7).epsilon(1e-3));
+  CHECK(s.steady_diameter == pft::rel(0.7, 1e-3));
   CHECK(s.t_f < 0.7);
   CHECK(std::fabs(s.t_mo - 0.9) <= 0.01 + 1e-12);  // the overshoot, to two samples
-  CHECK(s.overshoot_diameter == Approx(0.756).epsilon(3e-3));
+  CHECK(s.overshoot_diameter == pft::rel(0.756, 3e-3));
   CHECK(std::fabs(s.t_max_diameter - 1.8) <= 0.01 + 1e-12);  // the old definition: a breathing peak
-  CHECK(s.max_diameter == Approx(0.77).epsilon(3e-3));
+  CHECK(s.max_diameter == pft::rel(0.77, 3e-3));
   // Without the overshoot the first maximum is the end of the rise: the plateau at D_s
   // (0.7 to 0.9 s) that the dip towards 1.3 s falls back from.
   for (auto& r : h) r.canopy_diameter -= 0.056 * std::exp(-std::pow((r.t - 0.9) / 0.12, 2));
   const auto n = io::summarize(h);
   CHECK(n.t_mo >= 0.7 - 1e-12);
   CHECK(n.t_mo <= 0.9 + 1e-12);
-  CHECK(n.overshoot_diameter == Approx(0.7).epsilon(3e-3));
+  CHECK(n.overshoot_diameter == pft::rel(0.7, 3e-3));
 }
 
 // ------------------------------------------------------------------ descent mode
@@ -441,7 +443,7 @@ TEST_CASE("terminal means over whole swing periods: the swing's phase does not b
   CHECK(s.descent.swing_period == Approx(T).epsilon(1e-4));
   CHECK(s.terminal_window == Approx(T).epsilon(1e-3));  // one period: ⌈2 / 2.7⌉ = 1
   CHECK(s.v_terminal == Approx(7.0).epsilon(1e-4));
-  CHECK(s.cd_terminal == Approx(0.8).epsilon(1e-4));
+  CHECK(s.cd_terminal == pft::rel(0.8, 1e-4));
   // The fixed window (whole_periods off): the mean over [6.5, 8.5], off by the phase's share.
   io::summary_options fixed;
   fixed.whole_periods = false;
@@ -450,7 +452,7 @@ TEST_CASE("terminal means over whole swing periods: the swing's phase does not b
   REQUIRE(std::fabs(bias) > 0.02);  // the case is one where the window matters
   CHECK(f.terminal_window == Approx(2.0).epsilon(1e-9));
   CHECK(f.v_terminal == Approx(7.0 + bias).epsilon(2e-4));
-  CHECK(f.cd_terminal == Approx(0.8 + bias / 6.0).epsilon(2e-4));
+  CHECK(f.cd_terminal == pft::rel(0.8 + bias / 6.0, 2e-4));
   // A 5 s window holds ⌈5 / 2.7⌉ = 2 periods (5.4 s, inside [t_f, t_end]).
   io::summary_options longer;
   longer.window = 5.0;

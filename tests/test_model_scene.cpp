@@ -2,6 +2,8 @@
 // masses, the C-9 variant, rejection; the duct/screen scene of the coupling tests.
 #include <doctest/doctest.h>
 
+#include "approx.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -162,7 +164,7 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     const int N = 8;
     const double Ls = 1.0, Lr = 0.08;
     CHECK(p.line_length() == 1.0);
-    CHECK(p.riser_length() == doctest::Approx(0.08));
+    CHECK(p.riser_length() == pft::rel(0.08, 1e-12));
     // Lines: N lines, each Ls in rest length and in straight length, ending at the confluence.
     const auto& L = s.cable(md::cable_kind::suspension_line);
     CHECK(L.segments.size() == std::size_t(N * p.line_segments));
@@ -189,7 +191,7 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     CHECK((s.payload.hanging_point_world() - s.positions[std::size_t(s.suspension.hanging_point)]).norm() < 1e-12);
     CHECK((s.payload.position - Eigen::Vector3d(0, 0, 35)).norm() < 1e-12);
     CHECK(s.payload.mass == 1.8);
-    CHECK(s.payload.hanging_point.z() == doctest::Approx(0.05));
+    CHECK(s.payload.hanging_point.z() == pft::rel(0.05, 1e-12));
     CHECK(s.payload.inertia_diagonal.x() == doctest::Approx(1.8 / 12 * (0.15 * 0.15 + 0.1 * 0.1)));
     // Confluence distance from the skirt plane: sqrt(Ls^2 - rho^2), rho the packed skirt corner radius.
     const double rho =
@@ -332,7 +334,7 @@ TEST_CASE("scene data plugs into the structure module as is; lumped masses match
   // The membrane damping is irrelevant here (50 steps of free fall).
   auto chute = st::make_drop_assembly(s, 0.05);
   for (index_t i = 0; i < s.node_count(); ++i)
-    CHECK(chute.node_set().mass(i) == doctest::Approx(s.lumped_mass[std::size_t(i)]).epsilon(1e-12));
+    CHECK(chute.node_set().mass(i) == pft::rel(s.lumped_mass[std::size_t(i)], 1e-12));
   // The parts by name are the parts by position (0 membrane, 1-5 cables, 6 payload).
   CHECK(static_cast<const void*>(&st::canopy(chute)) == &chute.part<0>());
   CHECK(static_cast<const void*>(&st::suspension_lines(chute)) == &chute.part<1>());
@@ -346,7 +348,7 @@ TEST_CASE("scene data plugs into the structure module as is; lumped masses match
   CHECK(st::riser(chute).size() == index_t(s.cable(md::cable_kind::riser).segments.size()));
   // The body received the hanging node's lumped mass.
   CHECK(st::payload(chute).body().mass() ==
-        doctest::Approx(s.payload.mass + s.lumped_mass[std::size_t(s.suspension.hanging_point)]).epsilon(1e-12));
+        pft::rel(s.payload.mass + s.lumped_mass[std::size_t(s.suspension.hanging_point)], 1e-12));
   const double dt = chute.stable_dt();
   std::printf("assembly from the scene: stable structural step %.3e s\n", dt);
   CHECK(dt > 1e-6);
@@ -468,7 +470,7 @@ TEST_CASE("drop canopy travel: the travel limit's cells, or twice the fastest no
   f.p.V = Eigen::Vector3d(0, 0, -5);     // the box falls at 5 m/s
   f.p.Omega = Eigen::Vector3d(0, 0, 2);  // and turns about its z axis at 2 rad/s
   const double h = f.lay.cell_width(0, 2);
-  REQUIRE(h == doctest::Approx(0.05));
+  REQUIRE(h == pft::rel(0.05, 1e-12));
   pf::structure::nodes nd;
   nd.add({0.3, 0, 0}, {0, 0, -5});  // with the box's translation: 0.6 m/s relative (the turn at r = 0.3 m)
   nd.add({0, 0, 0}, {0, 3, -5});    // 3 m/s across the box axis: the fastest of the canopy

@@ -141,6 +141,9 @@ TEST_CASE("tests' pft::rel is relative at every size, where doctest::Approx is a
   CHECK(1e-14 != pft::rel(5e-15, 1e-9));
   CHECK(5e-15 * (1 + 1e-10) == pft::rel(5e-15, 1e-9));
   CHECK(-3e7 * (1 + 1e-10) == pft::rel(-3e7, 1e-9));
+  CHECK(-3e7 * (1 + 1e-8) != pft::rel(-3e7, 1e-9));
+  CHECK(2e-290 * (1 + 1e-8) != pft::rel(2e-290, 1e-9));
+  CHECK(0.0 == pft::rel(0.0, 1e-17));
   CHECK(0.0 == pft::rel(0.0, 1e-12));
   CHECK(1e-300 != pft::rel(0.0, 1e-12));
 }

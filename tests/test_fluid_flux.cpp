@@ -82,7 +82,7 @@ TEST_CASE("HLLC-LM reduces the dissipation of vortical low-Mach jumps, not of ac
   const double c = std::sqrt(1.4), du = 1e-4;
   const prim<double> A{1.0, {du, 0, 0}, 1.0 + 1.01 * c * du}, B{1.0, {0, 0, 0}, 1.0};
   const auto Flm = flux::hllc_lm{}(A, B, n, g), Fh = flux::hllc{}(A, B, n, g);
-  CHECK(Flm.rho == pft::rel(Fh.rho, 1e-12));
+  CHECK(Flm.rho == pft::rel(Fh.rho, 1e-10));  // equal in exact arithmetic; ~1e-12 apart in doubles
   CHECK(Flm.m.x == pft::rel(Fh.m.x, 1e-12));
   // The paper's form (no floor) keeps the acoustic dissipation low as well.
   const auto Fpaper = flux::hllc_lm{0.1, 0.0}(A, B, n, g);

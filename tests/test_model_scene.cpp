@@ -192,7 +192,7 @@ TEST_CASE("paper scene: lengths, confluence, masses, attachments, reference geom
     CHECK((s.payload.position - Eigen::Vector3d(0, 0, 35)).norm() < 1e-12);
     CHECK(s.payload.mass == 1.8);
     CHECK(s.payload.hanging_point.z() == pft::rel(0.05, 1e-12));
-    CHECK(s.payload.inertia_diagonal.x() == doctest::Approx(1.8 / 12 * (0.15 * 0.15 + 0.1 * 0.1)));
+    CHECK(s.payload.inertia_diagonal.x() == pft::rel(1.8 / 12 * (0.15 * 0.15 + 0.1 * 0.1), 1e-12));
     // Confluence distance from the skirt plane: sqrt(Ls^2 - rho^2), rho the packed skirt corner radius.
     const double rho =
         (s.frame.conjugate() * (s.positions[std::size_t(s.canopy.line_attachment[0])] - s.offset)).head<2>().norm();

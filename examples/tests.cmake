@@ -370,6 +370,12 @@ if(Python3_Interpreter_FOUND)
     COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/cli/test_descent_ensemble.py
             ${PROJECT_SOURCE_DIR}/scripts/descent_ensemble.py)
   set_tests_properties(script_descent_ensemble PROPERTIES TIMEOUT 120 LABELS examples SKIP_RETURN_CODE 77)
+  # scripts/opening_ensemble.py on synthetic drops with exact answers (the speed reached by
+  # t_p, the opening-load coefficient, group statistics and Welch's t); standard library only.
+  add_test(NAME script_opening_ensemble
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/cli/test_opening_ensemble.py
+            ${PROJECT_SOURCE_DIR}/scripts/opening_ensemble.py)
+  set_tests_properties(script_opening_ensemble PROPERTIES TIMEOUT 120 LABELS examples)
 endif()
 
 # ---- The drop over MPI processes (docs/guide_mpi.md): the tiny block-mesh drop for 0.05 s

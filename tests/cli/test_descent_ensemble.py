@@ -28,6 +28,8 @@ import subprocess
 import sys
 import tempfile
 
+from drop_csv import HISTORY_HEAD, SUMMARY_HEAD, table
+
 
 def python_with_numpy():
     for exe in (sys.executable, "/usr/bin/python3"):
@@ -41,8 +43,6 @@ if PYTHON is None:
     print("no python3 with numpy: skipped")
     sys.exit(77)
 
-HEAD = ("t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,"
-        "canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered")
 RUNS = {"A_o0": ("matA", 10.0, 0.84, 7.0), "A_o1": ("matA", 20.0, 0.81, 7.1),
         "B_o0": ("matB", 5.0, 0.7775, 7.2), "B_o1": ("matB", 15.0, 0.7575, 7.3)}
 LEEWARD = {"A_o0": -0.615, "A_o1": -0.600, "B_o0": -0.51875, "B_o1": -0.50875}
@@ -73,27 +73,16 @@ def write_run(root, name, fabric, tilt, cd, v, t_end=8.0):
     d = os.path.join(root, name)
     os.makedirs(d)
     with open(os.path.join(d, "history.csv"), "w") as f:
-        f.write(HEAD + "\n")
+        f.write(HISTORY_HEAD + "\n")
         n = int(round(t_end / 0.005))
         for i in range(n + 1):
             t = i * 0.005
             f.write(f"{t},0,0,0,0,0,{-v},{v},0.73,17.7,0,0,{tilt},0,90,{cd},17.7\n")
     with open(os.path.join(d, "summary.csv"), "w") as f:
-        f.write("fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode\n")
+        f.write(SUMMARY_HEAD + "\n")
         f.write(f"{fabric},0.7,0.8,0.75,{20 + tilt},{v},{cd},{tilt},vertical\n")
     return d
 
-
-def table(out, header):
-    """Rows after the line `header` until the next comment line, as lists of words."""
-    lines = out.splitlines()
-    i = lines.index(header)
-    rows = []
-    for line in lines[i + 1:]:
-        if line.startswith("#"):
-            break
-        rows.append(line.split())
-    return rows
 
 
 def close(a, b, tol=1e-9):

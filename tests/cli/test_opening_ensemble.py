@@ -18,10 +18,10 @@ import subprocess
 import sys
 import tempfile
 
+from drop_csv import HISTORY_HEAD, SUMMARY_HEAD, table
+
 RHO, S0, A = 1.2, 0.5, 8.0
 RUNS = {"A_o0": ("matA", 0.7, 1.8), "A_o1": ("matA", 0.8, 1.6), "B_o0": ("matB", 0.9, 1.2), "B_o1": ("matB", 0.75, 1.4)}
-HEAD = ("t,x,y,z,vx,vy,vz,speed,canopy_diameter,open_force,payload_phi_x,payload_phi_y,canopy_phi_x,"
-        "canopy_phi_y,flight_path_angle,drag_coefficient,open_force_filtered")
 
 
 def f_p(t_p, c_f):
@@ -32,26 +32,16 @@ def write_run(root, name, fabric, t_p, c_f, t_p_text=None):
     d = os.path.join(root, name)
     os.makedirs(d)
     with open(os.path.join(d, "history.csv"), "w") as f:
-        f.write(HEAD + "\n")
+        f.write(HISTORY_HEAD + "\n")
         for i in range(301):
             t = i * 0.005
             v = A * t if t <= t_p + 1e-12 else A * t_p * 2.0  # after t_p: faster, not counted
             f.write(f"{t},0,0,0,0,0,{-v},{v},0.5,1,0,0,0,0,90,0.8,1\n")
     with open(os.path.join(d, "summary.csv"), "w") as f:
-        f.write("fabric,t_f,t_mo,t_p,F_p,v_terminal,cd_terminal,attitude_amplitude,descent_mode\n")
+        f.write(SUMMARY_HEAD + "\n")
         f.write(f"{fabric},{t_p - 0.05},{t_p + 0.1},{t_p_text or t_p},{f_p(t_p, c_f)!r},5,0.8,3,vertical\n")
     return d
 
-
-def table(out, header):
-    lines = out.splitlines()
-    i = lines.index(header)
-    rows = []
-    for line in lines[i + 1:]:
-        if line.startswith("#"):
-            break
-        rows.append(line.split())
-    return rows
 
 
 def main():

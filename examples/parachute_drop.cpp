@@ -22,7 +22,9 @@
 // --permeability (another fabric's Ergun law on this cloth: the permeability isolated);
 // --payload-mass, --initial-speed (extreme scenes). A deployment's start: --packed bundle
 // (the canopy gathered at line stretch, --packed-parameter its mouth / D0) with
-// --initial-speed the speed at line stretch.
+// --initial-speed the speed at line stretch. A fixed canopy in a stream: --restart FILE
+// --captive SPEED holds the checkpoint's shape and moves it at SPEED along its axis
+// (with --permeability F, the same shape with fabric F's law).
 //
 // Writes in DIR: history.csv (one row per --history-every ≤ 5 ms; its last column the
 // riser force low-pass filtered at --force-cutoff, 10 Hz), summary.csv, and
@@ -133,6 +135,12 @@ int main(int argc, char** argv) {
       ->check(finite)
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--restart", c.restart, "restart from this checkpoint file");
+  app.add_option("--captive", c.captive_speed,
+                 "a captive canopy: from the --restart checkpoint on, hold the structure in its shape and move it as "
+                 "one body at this speed (m/s) along the canopy's axis through still air (drag in cloth_pressure.csv; "
+                 "with --permeability another fabric's law on the same shape); 0: off")
+      ->check(finite)
+      ->check(CLI::Range(0.0, 200.0));
   app.add_option("--threads", threads, "OpenMP threads (0: OMP_NUM_THREADS)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();

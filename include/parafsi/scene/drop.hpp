@@ -166,7 +166,14 @@ struct drop_config {
   double vtk_every = 0;  ///< VTK (.vtu structure, .vts/.vtu fluid or .pvtu pieces, drop.pvd) interval (s), 0 = none
   double checkpoint_every = 0;  ///< checkpoint interval (s), 0 = none; file <out>/checkpoint.ckpt
   std::string restart;          ///< checkpoint to continue from (same scene and flags)
-  bool quiet = false;           ///< no messages on stderr
+  /// > 0: a captive canopy (m/s). From the restart on, the structure is held in the shape
+  /// of the checkpoint (structure::assembly::hold) and moves as one rigid body at this
+  /// speed along the canopy's axis, vent → confluence, through the still air: the same
+  /// shape in a steady stream, with no swing and no breathing, its drag read from
+  /// cloth_pressure.csv. Needs --restart (of a run with the canopy's own fabric law; the
+  /// captive run may give another with `permeability`); writes no checkpoint.
+  double captive_speed = 0;
+  bool quiet = false;  ///< no messages on stderr
   /// Block mesh over several processes (set by a distributed program, e.g. with
   /// mpi::block_halo: every level split with the embedded coupling; with the penalty
   /// coupling replicate_finest, the canopy's level computed by every process); every process
@@ -242,7 +249,8 @@ struct drop_config {
                                                       {"packed_parameter", packed_parameter},
                                                       {"fixed_fall", fixed_fall},
                                                       {"vtk_every", vtk_every},
-                                                      {"checkpoint_every", checkpoint_every}};
+                                                      {"checkpoint_every", checkpoint_every},
+                                                      {"captive_speed", captive_speed}};
     for (const auto& [name, v] : numbers)
       require(std::isfinite(v), "parachute_drop: ", name, " must be a finite number, got ", v);
     for (double t : slice_times)
@@ -300,6 +308,19 @@ struct drop_config {
               history_every, " s)");
     require(box != "fixed" || fixed_fall > 0,
             "parachute_drop: a fixed box needs the fall length it must hold (> 0 m), got ", fixed_fall);
+    require(captive_speed >= 0 && captive_speed <= 200,
+            "parachute_drop: --captive speed must be in [0, 200] m/s (0: "
+            "off), got ",
+            captive_speed);
+    if (captive_speed > 0) {
+      require(!restart.empty(),
+              "parachute_drop: --captive holds the canopy in the shape of a checkpoint: give "
+              "--restart FILE");
+      require(checkpoint_every == 0,
+              "parachute_drop: --captive writes no checkpoint (the hold is not saved); drop "
+              "--checkpoint-every");
+      require(box == "follow", "parachute_drop: --captive needs the following box (--box follow)");
+    }
   }
 };
 
@@ -489,6 +510,7 @@ class drop_run {
     const auto& nd = s_.structure().node_set();
     history_ = &res.history;
     if (!c_.restart.empty()) res.history = restart();
+    if (c_.captive_speed > 0) hold_captive();
     open_outputs();
     emit(false);  // carried rows: those whose filter window is complete
     if constexpr (block_mesh) {
@@ -623,7 +645,14 @@ class drop_run {
   /// The stepper's state from the checkpoint (its scene signature compared first); the
   /// history rows up to its time, from the checkpoint.
   std::vector<io::drop_history_row> restart() {
+    // A captive run may give the cloth another fabric's law: the checkpoint is of a run
+    // with the canopy's own.
     io::scene_signature sig = signature_;
+    if (c_.captive_speed > 0) {
+      drop_config own = c_;
+      own.permeability.clear();
+      sig = drop_signature(own, su_);
+    }
     io::drop_history_record previous;
     io::load_checkpoint(c_.restart, sig, s_, previous);
     // The checkpoint holds the fluid, not the far field: a run restarted with another α
@@ -645,6 +674,22 @@ class drop_run {
       std::fprintf(stderr, "parachute_drop: restarted from %s at t = %.6g s (%zu history rows carried)\n",
                    c_.restart.c_str(), s_.time(), previous.rows.size());
     return std::move(previous.rows);
+  }
+
+  /// --captive: hold the structure in its restored shape, moving at the captive speed
+  /// along the canopy's axis (vent centre → line confluence).
+  void hold_captive() {
+    const auto& nd = s_.structure().node_set();
+    const Eigen::Vector3d axis = nd.position(su_.scene.suspension.confluence) - observe_.vent_point(nd);
+    require(axis.norm() > 0, "parachute_drop: --captive: the canopy's axis has zero length");
+    const Eigen::Vector3d V = c_.captive_speed * axis.normalized();
+    s_.structure().hold(V);
+    if (!c_.quiet)
+      std::fprintf(stderr,
+                   "parachute_drop: captive canopy: the structure held in its shape at t = %.6g s, moving at %.4g m/s "
+                   "along its axis (%.4f, %.4f, %.4f); its drag is in cloth_pressure.csv\n",
+                   s_.time(), c_.captive_speed, V.x() / c_.captive_speed, V.y() / c_.captive_speed,
+                   V.z() / c_.captive_speed);
   }
 
   /// history.csv (its header; the rows follow through `emit`); the VTK series.

@@ -6,7 +6,9 @@
 ///   place_attached_nodes → clear_forces (f = m g) → external loads (coupling hook)
 ///   → compute_element_forces (every element part, race-free) → scatter_element_forces
 ///   → step_bodies (node forces → body force + moment, body leapfrog)
-///   → update_nodes (kick/drift) → check (numerical_failure naming node, element, time).
+///   → update_nodes (kick/drift) → check (numerical_failure naming node, element, time);
+/// held (`hold(V)`, a captive structure): the loads and element forces as above, then
+/// every body and node translates at V (step_bodies and update_nodes replaced).
 /// `advance(Δt_f)` runs m = ceil(Δt_f/Δt_s,crit) equal substeps inside one fluid step,
 /// Δt_s,crit = TSSF · min(membrane element limits, nodal line limits, body limits).
 ///
@@ -19,7 +21,7 @@
 /// `critical_dt(const nodes&)`, `strain_energy()`, `first_bad_element()` and
 /// optionally `post_finalize(const nodes&)`, `add_node_stiffness(vector&)`,
 /// `damping_ratio()`; body parts (`is_body = true`) provide `finalize`,
-/// `post_finalize`, `place_nodes`, `step`, `critical_dt(ksum)` and momenta/energy.
+/// `post_finalize`, `place_nodes`, `step`, `translate(V, dt)`, `critical_dt(ksum)` and momenta/energy.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -167,6 +169,30 @@ class assembly {
         parts_);
     return cd_.tssf * dt;
   }
+
+  /// Hold the structure captive: from the next substep on, every node and body moves as
+  /// one rigid translation at the velocity V (nodes x += V Δt, v = V whatever their
+  /// constraint; bodies rigid_body::translate), so the shape of now is kept exactly. The
+  /// loads (the load hook, element forces) are still evaluated each substep, so what a
+  /// caller reads from them (a coupling's impulses on the cloth) is what the held shape
+  /// feels; nothing responds to them. The same structure in a stream: a fixed canopy in
+  /// the drop's air (scene::drop_config::captive_speed). Not saved by a checkpoint: hold
+  /// again after a load. release_hold() returns to the free update.
+  void hold(const Eigen::Vector3d& V) {
+    require(V.allFinite(), "assembly::hold: non-finite velocity (", V.transpose(), ")");
+    if (nodes_.needs_finalize()) finalize();
+    held_ = true;
+    hold_velocity_ = V;
+    auto& s = nodes_.data();
+    for (index_t i = 0; i < nodes_.size(); ++i) {
+      s.template get<field::vx>()[i] = V.x();
+      s.template get<field::vy>()[i] = V.y();
+      s.template get<field::vz>()[i] = V.z();
+    }
+  }
+  void release_hold() noexcept { held_ = false; }
+  bool held() const noexcept { return held_; }
+  const Eigen::Vector3d& hold_velocity() const noexcept { return hold_velocity_; }
 
   /// Advance by dt_outer in m = ceil(dt_outer/stable_dt()) equal substeps; returns m.
   template <class Loads = no_loads>
@@ -376,6 +402,17 @@ class assembly {
   void substep(double dt, Loads& loads) {
     const double dt_kick = 0.5 * (dt_prev_ + dt);
     const double strain = compute_phase<Track>(loads);
+    if (held_) {
+      held_update(dt);
+      if constexpr (Track) {
+        ledger_.kinetic = kinetic_energy();
+        ledger_.strain = strain;
+      }
+      t_ += dt;
+      dt_prev_ = dt;
+      ++steps_;
+      return;
+    }
     // Phase 4. Rigid bodies.
     double w_body = 0;
     std::apply(
@@ -402,6 +439,27 @@ class assembly {
     t_ += dt;
     dt_prev_ = dt;
     ++steps_;
+  }
+
+  /// Phases 4–5 of a held substep (hold()): bodies and nodes translate at V.
+  void held_update(double dt) {
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) p.translate(hold_velocity_, dt);
+          }(),
+          ...);
+        },
+        parts_);
+    auto& s = nodes_.data();
+    double* x[3] = {s.template get<field::x>(), s.template get<field::y>(), s.template get<field::z>()};
+    double* v[3] = {s.template get<field::vx>(), s.template get<field::vy>(), s.template get<field::vz>()};
+    for (int d = 0; d < 3; ++d)
+      for (index_t i = 0; i < nodes_.size(); ++i) {
+        x[d][i] += hold_velocity_[d] * dt;
+        v[d][i] = hold_velocity_[d];
+      }
   }
 
   [[noreturn]] void fail(index_t node) {
@@ -432,6 +490,8 @@ class assembly {
   double t_ = 0, dt_prev_ = 0;
   long steps_ = 0;
   bool track_ = false;
+  bool held_ = false;                                        ///< hold(): rigid translation
+  Eigen::Vector3d hold_velocity_ = Eigen::Vector3d::Zero();  ///< its velocity (m/s)
   energy_ledger ledger_{};
 };
 

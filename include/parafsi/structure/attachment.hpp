@@ -96,6 +96,13 @@ class attachment {
     return dt_kick * fg.dot(0.5 * (p0 + p1) / body_.mass());
   }
 
+  /// The held step (assembly::hold): the body translates at V over dt whatever the
+  /// node forces on it (rigid_body::translate); returns the external work, 0.
+  double translate(const Eigen::Vector3d& V, double dt) {
+    body_.translate(V, dt);
+    return 0.0;
+  }
+
   /// Body limit and the attachment-spring limit (ksum: Σ k_e per node).
   double critical_dt(const std::vector<double>& ksum) const {
     double dt = body_.critical_dt();

@@ -260,6 +260,23 @@ class rigid_body {
                               -1, s_.time);
   }
 
+  /// A step of length dt as a rigid translation at the velocity V, whatever the loads:
+  /// the mass centre moves by V dt, the attitude stays, P = m V and L = ω_b = 0 (the
+  /// body held captive, structure::assembly::hold). The pending loads are cleared.
+  void translate(const Eigen::Vector3d& V, double dt) {
+    require(std::isfinite(dt) && dt > 0, "rigid_body::translate: time step must be positive, got ", dt);
+    require(V.allFinite(), "rigid_body::translate: non-finite velocity (", V.transpose(), ")");
+    clear_loads();
+    s_.x_com += dt * V;
+    s_.p = s_.mass * V;
+    s_.l.setZero();
+    s_.omega_body.setZero();
+    s_.q_half = s_.q;
+    s_.dt_prev = dt;
+    s_.time += dt;
+    ++s_.steps;
+  }
+
   /// Rotational limit: the body may turn at most max_rotation_per_step (0.1 rad) per
   /// step, Δt ≤ 0.1/|ω|. The rate of change of ω_b in the body frame is at most |ω|²
   /// (|J_j − J_k| ≤ J_i), so this also keeps the fixed point strongly contracting.

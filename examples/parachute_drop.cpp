@@ -141,6 +141,11 @@ int main(int argc, char** argv) {
                  "with --permeability another fabric's law on the same shape); 0: off")
       ->check(finite)
       ->check(CLI::Range(0.0, 200.0));
+  app.add_option("--captive-hold", c.captive_hold,
+                 "--captive: hold the whole structure (structure: a fixed shape) or the payload only (payload: the "
+                 "canopy and lines free to breathe and turn about it, as on a wind tunnel's sting)")
+      ->check(CLI::IsMember({"structure", "payload"}))
+      ->capture_default_str();
   app.add_option("--threads", threads, "OpenMP threads (0: OMP_NUM_THREADS)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();

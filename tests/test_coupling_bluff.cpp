@@ -28,7 +28,8 @@ struct drag_result {
   double cd = 0, through = 0;  ///< means over the second half: C_d, through-velocity / U
   /// The cloth's two sides (coupling::embedded::cloth_sides along the stream): mean gauge C_p
   /// windward and leeward over the second half, and the largest difference over all steps
-  /// between their load (p_w − p_l) S and the coupling's impulse along the stream / Δt,
+  /// between their load (p_w − p_l) S and the coupling's impulse along the stream / Δt, and
+  /// between their load vector (cloth_side_means::pressure_load) and the impulse vector / Δt,
   /// relative to the larger of that force and ½ρU²πR².
   double windward_cp = 0, leeward_cp = 0, load_identity = 0;
   /// The stream's total pressure one diameter ahead on the axis, (p − p∞)/q + |u|²/U², over the
@@ -83,6 +84,9 @@ drag_result disk_drag(int cells, double flow_times, Coupling cpl, box_extent box
     const double load = (cs.windward_pressure - cs.leeward_pressure) * cs.projected_area;
     REQUIRE(std::isfinite(load));
     identity = std::max(identity, std::fabs(load - fx) / std::max(std::fabs(fx), qA));
+    // The load as a vector (side force included): the coupling's whole impulse / Δt.
+    const Eigen::Vector3d F = s.coupling().diagnostics().impulse_structure / dt;
+    identity = std::max(identity, (cs.pressure_load - F).norm() / std::max(F.norm(), qA));
     const double w = s.time() - std::max(t0, t_avg);
     if (w > 0) {
       sum += cd * w;

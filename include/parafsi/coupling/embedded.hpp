@@ -175,6 +175,10 @@ struct cloth_side_means {
   /// the law's inverse is each face's own u_p and the faces pass more than this sum.
   double through_flow = 0;
   index_t faces = 0;  ///< the faces with n_f·e ≠ 0
+  /// The cloth's pressure load as a vector, Σ_f A_f (p*_low − p*_high) n_f over every face
+  /// (N; world frame): along e it is (windward − leeward) · projected_area, across e the
+  /// side force of a canopy at an angle to the stream (its lift).
+  Eigen::Vector3d pressure_load = Eigen::Vector3d::Zero();
 };
 
 /// `OneSided`: reconstruct the cells beside a membrane face from their own side (second
@@ -221,6 +225,14 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
   /// the stream's direction relative to the cloth: −V for a canopy falling at V) and the air
   /// crossing it, over the last step (definitions: cloth_side_means).
   cloth_side_means cloth_sides(const Eigen::Vector3d& e) const {
+    return cloth_sides(e, [](index_t) { return true; });
+  }
+  /// The same over the faces whose cloth is element `elem` (of the coupled triangles; a face
+  /// crossed by several layers goes by its first) with `select(elem)` true: a part of the
+  /// cloth, e.g. a ring of the canopy (the drop's cloth_bands.csv). The parts of a partition
+  /// add up to the whole: S, S × each pressure and the through-flow.
+  template <class Select>
+  cloth_side_means cloth_sides(const Eigen::Vector3d& e, Select&& select) const {
     require(std::isfinite(e.squaredNorm()) && std::fabs(e.norm() - 1.0) < 1e-9,
             "coupling::embedded::cloth_sides: the direction must be a unit vector, got (", e.x(), ", ", e.y(), ", ",
             e.z(), ")");
@@ -228,8 +240,10 @@ class embedded : public detail::membrane_coupling<embedded<Porosity, OneSided>, 
     double pw = 0, pl = 0;
     for (std::size_t i = 0; i < faces_.size() && i < side_p_.size(); ++i) {
       const face_rec& fr = faces_[i];
+      if (fr.n < 1 || !select(crossings_[std::size_t(fr.first)].elem)) continue;
       const double ne = face_R_.col(fr.axis).dot(e), w = fr.area * std::fabs(ne);
       const auto& p = side_p_[i];
+      r.pressure_load += (fr.area * (p[0] - p[1])) * face_R_.col(fr.axis);
       if (w > 0) {
         r.projected_area += w;
         pw += w * (ne > 0 ? p[0] : p[1]);

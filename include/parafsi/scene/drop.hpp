@@ -173,6 +173,10 @@ struct drop_config {
   /// cloth_pressure.csv. Needs --restart (of a run with the canopy's own fabric law; the
   /// captive run may give another with `permeability`); writes no checkpoint.
   double captive_speed = 0;
+  /// --captive: what is held, the whole structure (structure: a fixed shape) or the payload
+  /// only (payload: the canopy and lines free to breathe and to turn about the payload,
+  /// which moves at the captive speed without turning, as on a wind tunnel's sting)
+  std::string captive_hold = "structure";
   bool quiet = false;  ///< no messages on stderr
   /// Block mesh over several processes (set by a distributed program, e.g. with
   /// mpi::block_halo: every level split with the embedded coupling; with the penalty
@@ -320,6 +324,8 @@ struct drop_config {
               "parachute_drop: --captive writes no checkpoint (the hold is not saved); drop "
               "--checkpoint-every");
       require(box == "follow", "parachute_drop: --captive needs the following box (--box follow)");
+      require(captive_hold == "structure" || captive_hold == "payload",
+              "parachute_drop: --captive-hold must be structure or payload, got '", captive_hold, "'");
     }
   }
 };
@@ -470,6 +476,26 @@ inline std::string drop_fabric_label(const drop_config& c, const drop_setup& su)
   return label;
 }
 
+/// The rings of cloth_bands.csv: the canopy's cut pattern from the vent edge R_v to the
+/// skirt R_s in cloth_band_count rings of equal width, ring 0 at the vent (the crown) and the
+/// last at the skirt; each canopy triangle goes by its centroid's radius on the pattern, so a
+/// ring is the same cloth whatever the canopy's shape. Returned per triangle of the scene
+/// (−1 for a triangle that is not the canopy's).
+inline constexpr int cloth_band_count = 4;
+inline std::vector<int> cloth_bands(const model::drop_scene& sc) {
+  std::vector<int> band(sc.triangles.size(), -1);
+  const auto& pat = sc.canopy.positions;
+  const double Rv = sc.canopy.vent_radius, Rs = sc.canopy.skirt_radius;
+  for (std::size_t e = 0; e < sc.triangles.size(); ++e) {
+    const auto& t = sc.triangles[e];
+    if (std::size_t(t[0]) >= pat.size() || std::size_t(t[1]) >= pat.size() || std::size_t(t[2]) >= pat.size()) continue;
+    const Eigen::Vector3d c = (pat[std::size_t(t[0])] + pat[std::size_t(t[1])] + pat[std::size_t(t[2])]) / 3.0;
+    const double u = (std::hypot(c.x(), c.y()) - Rv) / (Rs - Rv);
+    band[e] = std::clamp(int(std::floor(u * cloth_band_count)), 0, cloth_band_count - 1);
+  }
+  return band;
+}
+
 namespace detail {
 
 /// One run of a built drop: the stepper (constructed in place: the coupling holds
@@ -563,6 +589,7 @@ class drop_run {
     res.canopy_travel_ratio = travel_ratio_;
     if (mesh_csv_) mesh_csv_->close();
     if (cloth_csv_) cloth_csv_->close();
+    if (bands_csv_) bands_csv_->close();
     if (!c_.quiet)  // subcycled, a step is one of the coarsest level, holding 2^levels of the finest
       std::fprintf(stderr,
                    "parachute_drop: %ld fluid steps%s, %.1f structure substeps per step; wall %.1f s (frame %.1f, "
@@ -683,11 +710,14 @@ class drop_run {
     const Eigen::Vector3d axis = nd.position(su_.scene.suspension.confluence) - observe_.vent_point(nd);
     require(axis.norm() > 0, "parachute_drop: --captive: the canopy's axis has zero length");
     const Eigen::Vector3d V = c_.captive_speed * axis.normalized();
-    s_.structure().hold(V);
+    using scope = structure::drop_assembly::hold_scope;
+    const bool whole = c_.captive_hold == "structure";
+    s_.structure().hold(V, whole ? scope::structure : scope::bodies);
     if (!c_.quiet)
       std::fprintf(stderr,
-                   "parachute_drop: captive canopy: the structure held in its shape at t = %.6g s, moving at %.4g m/s "
-                   "along its axis (%.4f, %.4f, %.4f); its drag is in cloth_pressure.csv\n",
+                   "parachute_drop: captive canopy: %s at t = %.6g s, moving at %.4g m/s along the canopy's axis "
+                   "(%.4f, %.4f, %.4f); its drag is in cloth_pressure.csv\n",
+                   whole ? "the structure held in its shape" : "the payload held (the canopy and lines free)",
                    s_.time(), c_.captive_speed, V.x() / c_.captive_speed, V.y() / c_.captive_speed,
                    V.z() / c_.captive_speed);
   }
@@ -704,10 +734,17 @@ class drop_run {
       for (int l = 0; l <= levels_; ++l) cols.push_back("cells_level_" + std::to_string(l));
       mesh_csv_.emplace(out() / "mesh.csv", std::move(cols), resume_options());
     }
-    if constexpr (cloth_sides)
+    if constexpr (cloth_sides) {
       cloth_csv_.emplace(out() / "cloth_pressure.csv",
                          std::vector<std::string>(std::begin(cloth_columns), std::end(cloth_columns)),
                          resume_options());
+      std::vector<std::string> cols{"t"};
+      for (int k = 1; k <= cloth_band_count; ++k)
+        for (const char* name : {"area", "windward_cp", "leeward_cp", "pressure_drag_coefficient", "through_fraction"})
+          cols.push_back("band" + std::to_string(k) + "_" + name);
+      bands_csv_.emplace(out() / "cloth_bands.csv", std::move(cols), resume_options());
+      band_of_ = cloth_bands(su_.scene);
+    }
     if (c_.vtk_every > 0) {
       std::filesystem::create_directories(out() / "vtk");
       pvd_.emplace(out() / "drop.pvd", c_.restart.empty() ? std::numeric_limits<double>::quiet_NaN() : s_.time());
@@ -724,7 +761,7 @@ class drop_run {
   /// The columns of cloth_pressure.csv (embedded coupling; definitions in record_cloth).
   static constexpr const char* cloth_columns[] = {
       "t",           "projected_area", "windward_pressure",         "leeward_pressure", "through_flow",
-      "windward_cp", "leeward_cp",     "pressure_drag_coefficient", "through_fraction"};
+      "windward_cp", "leeward_cp",     "pressure_drag_coefficient", "through_fraction", "side_force_coefficient"};
 
   /// A row of cloth_pressure.csv: the canopy's cloth seen along the stream e = −V/|V| (V the
   /// payload's velocity; the box axis when it is at rest), from the embedded coupling's wall
@@ -737,7 +774,9 @@ class drop_run {
   /// (the cloth's pressure load along the stream on S0 = π D0²/4; in a steady descent without
   /// swing about the history's drag_coefficient, the rest the swept terms; in a swing about
   /// cos θ of it, the load leaving the payload's path: validation §3.5),
-  /// through_fraction = Q/(|V| S). The two pressures and the four coefficients are nan while
+  /// through_fraction = Q/(|V| S), side_force_coefficient = |F − (F·e) e|/(q S0) with F the
+  /// cloth's pressure load vector (the load across the stream: the lift of a canopy at an
+  /// angle to it; validation §3.7). The two pressures and the five coefficients are nan while
   /// no face is seen along e (S = 0: before the first step), the coefficients also while the
   /// payload is at rest.
   void record_cloth(const io::drop_history_row& r) {
@@ -751,10 +790,25 @@ class drop_run {
       const double pw = cs.windward_pressure - q_inf, pl = cs.leeward_pressure - q_inf;
       const double q = 0.5 * su_.params.air_density * v * v, nan = std::numeric_limits<double>::quiet_NaN();
       const bool seen = cs.projected_area > 0, moving = seen && q > 0;
-      cloth_csv_->row({r.t, cs.projected_area, seen ? pw : nan, seen ? pl : nan, cs.through_flow, moving ? pw / q : nan,
-                       moving ? pl / q : nan,
-                       moving ? (pw - pl) * cs.projected_area / (q * su_.params.nominal_area()) : nan,
-                       moving ? cs.through_flow / (v * cs.projected_area) : nan});
+      cloth_csv_->row(
+          {r.t, cs.projected_area, seen ? pw : nan, seen ? pl : nan, cs.through_flow, moving ? pw / q : nan,
+           moving ? pl / q : nan, moving ? (pw - pl) * cs.projected_area / (q * su_.params.nominal_area()) : nan,
+           moving ? cs.through_flow / (v * cs.projected_area) : nan,
+           moving ? (cs.pressure_load - cs.pressure_load.dot(e) * e).norm() / (q * su_.params.nominal_area()) : nan});
+      // cloth_bands.csv: the same per ring of the cut pattern (cloth_bands), the pressure
+      // drag and the through-fraction on the whole canopy's q S0 and V S, so the bands add up.
+      std::vector<double> row{r.t};
+      for (int k = 0; k < cloth_band_count; ++k) {
+        const auto b = s_.coupling().cloth_sides(e, [&](index_t el) {
+          return std::size_t(el) < band_of_.size() && band_of_[std::size_t(el)] == k;
+        });
+        const double bw = b.windward_pressure - q_inf, bl = b.leeward_pressure - q_inf;
+        const bool bseen = b.projected_area > 0 && moving;
+        row.insert(row.end(), {b.projected_area, bseen ? bw / q : nan, bseen ? bl / q : nan,
+                               bseen ? (bw - bl) * b.projected_area / (q * su_.params.nominal_area()) : 0.0,
+                               moving ? b.through_flow / (v * cs.projected_area) : nan});
+      }
+      bands_csv_->row(row);
     } else {
       (void)r;
     }
@@ -988,6 +1042,8 @@ class drop_run {
   /// The coupling reports the pressures on the two sides of the cloth (embedded).
   static constexpr bool cloth_sides = requires(const Coupling& c) { c.cloth_sides(Eigen::Vector3d::UnitZ()); };
   std::optional<io::csv_writer> cloth_csv_;   ///< embedded coupling: cloth_pressure.csv
+  std::optional<io::csv_writer> bands_csv_;   ///< embedded coupling: cloth_bands.csv
+  std::vector<int> band_of_;                  ///< the ring (cloth_bands) of each canopy triangle
   std::vector<Eigen::Vector3d> wall_points_;  ///< mixing length: the structure's nodes in box coordinates
   long mesh_rows_ = 0, regrids_ = 0, max_cells_ = 0, counted_steps_ = 0;
   /// Block mesh: the longest step the last regrid's canopy buffer allows (drop_canopy_travel).

@@ -8,7 +8,8 @@
 ///   → step_bodies (node forces → body force + moment, body leapfrog)
 ///   → update_nodes (kick/drift) → check (numerical_failure naming node, element, time);
 /// held (`hold(V)`, a captive structure): the loads and element forces as above, then
-/// every body and node translates at V (step_bodies and update_nodes replaced).
+/// every body and node translates at V (step_bodies and update_nodes replaced); with
+/// `hold(V, hold_scope::bodies)` only step_bodies is replaced (a canopy on a held payload).
 /// `advance(Δt_f)` runs m = ceil(Δt_f/Δt_s,crit) equal substeps inside one fluid step,
 /// Δt_s,crit = TSSF · min(membrane element limits, nodal line limits, body limits).
 ///
@@ -170,19 +171,27 @@ class assembly {
     return cd_.tssf * dt;
   }
 
+  /// What hold() holds: the whole structure, or its rigid bodies only.
+  enum class hold_scope { structure, bodies };
   /// Hold the structure captive: from the next substep on, every node and body moves as
   /// one rigid translation at the velocity V (nodes x += V Δt, v = V whatever their
   /// constraint; bodies rigid_body::translate), so the shape of now is kept exactly. The
   /// loads (the load hook, element forces) are still evaluated each substep, so what a
   /// caller reads from them (a coupling's impulses on the cloth) is what the held shape
   /// feels; nothing responds to them. The same structure in a stream: a fixed canopy in
-  /// the drop's air (scene::drop_config::captive_speed). Not saved by a checkpoint: hold
-  /// again after a load. release_hold() returns to the free update.
-  void hold(const Eigen::Vector3d& V) {
+  /// the drop's air (scene::drop_config::captive_speed).
+  /// With hold_scope::bodies only the rigid bodies translate at V (attitude kept); the
+  /// nodes they carry follow them and every other node moves under its loads as before: a
+  /// canopy on a held payload, free to breathe and to turn about its lines, as in a wind
+  /// tunnel. Not saved by a checkpoint: hold again after a load. release_hold() returns to
+  /// the free update.
+  void hold(const Eigen::Vector3d& V, hold_scope scope = hold_scope::structure) {
     require(V.allFinite(), "assembly::hold: non-finite velocity (", V.transpose(), ")");
     if (nodes_.needs_finalize()) finalize();
     held_ = true;
+    hold_scope_ = scope;
     hold_velocity_ = V;
+    if (scope == hold_scope::bodies) return;
     auto& s = nodes_.data();
     for (index_t i = 0; i < nodes_.size(); ++i) {
       s.template get<field::vx>()[i] = V.x();
@@ -192,6 +201,7 @@ class assembly {
   }
   void release_hold() noexcept { held_ = false; }
   bool held() const noexcept { return held_; }
+  hold_scope held_scope() const noexcept { return hold_scope_; }
   const Eigen::Vector3d& hold_velocity() const noexcept { return hold_velocity_; }
 
   /// Advance by dt_outer in m = ceil(dt_outer/stable_dt()) equal substeps; returns m.
@@ -402,7 +412,7 @@ class assembly {
   void substep(double dt, Loads& loads) {
     const double dt_kick = 0.5 * (dt_prev_ + dt);
     const double strain = compute_phase<Track>(loads);
-    if (held_) {
+    if (held_ && hold_scope_ == hold_scope::structure) {
       held_update(dt);
       if constexpr (Track) {
         ledger_.kinetic = kinetic_energy();
@@ -420,7 +430,7 @@ class assembly {
       (
           (void)[&] {
             if constexpr (body_part<std::remove_cvref_t<decltype(p)>>)
-              w_body += p.step(nodes_, cd_.gravity, dt_kick, dt);
+              w_body += held_ ? p.translate(hold_velocity_, dt) : p.step(nodes_, cd_.gravity, dt_kick, dt);
           }(),
           ...);
         },
@@ -490,6 +500,7 @@ class assembly {
   double t_ = 0, dt_prev_ = 0;
   long steps_ = 0;
   bool track_ = false;
+  hold_scope hold_scope_ = hold_scope::structure;            ///< of what
   bool held_ = false;                                        ///< hold(): rigid translation
   Eigen::Vector3d hold_velocity_ = Eigen::Vector3d::Zero();  ///< its velocity (m/s)
   energy_ledger ledger_{};

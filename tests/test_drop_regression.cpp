@@ -242,6 +242,37 @@ TEST_CASE("drop: cloth_pressure.csv, the loaded canopy's two sides, on the box a
     MESSAGE("side force coefficient ", e[9], " against C_D,p ", e[7]);
     CHECK(e[9] >= 0);
     if (c.mesh == "tensor") CHECK(e[9] < 0.7 * e[7]);
+    // cloth_bands.csv: the rings of the cut pattern add up to the whole cloth, row by row.
+    std::ifstream bin(dir / "cloth_bands.csv");
+    REQUIRE(bin.good());
+    std::getline(bin, line);
+    CHECK(line.rfind("t,band1_area,band1_windward_cp,band1_leeward_cp,band1_pressure_drag_coefficient,"
+                     "band1_through_fraction,band2_area",
+                     0) == 0);
+    std::vector<double> b;
+    while (std::getline(bin, line)) {
+      b.clear();
+      std::stringstream ls(line);
+      for (std::string cell; std::getline(ls, cell, ',');) b.push_back(std::stod(cell));
+    }
+    REQUIRE(b.size() == 21);
+    CHECK(b[0] == e[0]);
+    double S = 0, Sw = 0, Sl = 0, cdp = 0, tf = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double* r = &b[std::size_t(1 + 5 * k)];
+      S += r[0];
+      if (r[0] > 0) {
+        Sw += r[0] * r[1];
+        Sl += r[0] * r[2];
+      }
+      cdp += r[3];
+      tf += r[4];
+    }
+    CHECK(S == pft::rel(e[1], 1e-12));
+    CHECK(Sw / S == pft::rel(e[5], 1e-9));
+    CHECK(Sl / S == pft::rel(e[6], 1e-9));
+    CHECK(cdp == pft::rel(e[7], 1e-9));
+    CHECK(tf == pft::rel(e[8], 1e-9));
   }
   fs::remove_all(dir);
 }
@@ -582,6 +613,8 @@ TEST_CASE("drop --captive: the checkpoint's shape moves rigidly at the captive s
     CHECK(h.z == pft::rel(h0.z + h.vz * (h.t - h0.t), 1e-9));
   }
   const auto e_own = through_fraction("own"), e_open = through_fraction("open");
+  CHECK(e_own[7] > 0);  // a pressure drag along the stream
+  CHECK(e_open[7] > 0);
   MESSAGE("captive tiny canopy at 7 m/s: C_D,p ", e_own[7], " (own law), ", e_open[7], " (mat509's); through-fraction ",
           e_own[8], " and ", e_open[8]);
   // The same shape: the projected area on the staircase faces, Σ A_f |n_f·e|, differs only
@@ -602,21 +635,41 @@ TEST_CASE("drop --captive: the checkpoint's shape moves rigidly at the captive s
   const auto sting = sc::run_drop(p);
   REQUIRE(sting.history.size() == 41);
   double d_min = 1e300, d_max = 0;
+  const auto& s0 = sting.history[20];
   for (std::size_t i = 21; i < sting.history.size(); ++i) {
-    CHECK(sting.history[i].speed == pft::rel(7.0, 1e-12));
+    const auto& h = sting.history[i];
+    CHECK(h.speed == pft::rel(7.0, 1e-12));
+    CHECK(h.z == pft::rel(s0.z + h.vz * (h.t - s0.t), 1e-9));                     // from the restored place on
+    CHECK(std::fabs(h.payload_phi_x - sting.history[21].payload_phi_x) <= 1e-9);  // held without turning
+    CHECK(std::fabs(h.payload_phi_y - sting.history[21].payload_phi_y) <= 1e-9);
+    CHECK(std::isfinite(h.open_force));
     d_min = std::min(d_min, sting.history[i].canopy_diameter);
     d_max = std::max(d_max, sting.history[i].canopy_diameter);
   }
   CHECK(d_max > (1.0 + 1e-3) * d_min);
-  // Refused: without a checkpoint, with checkpoints, from a run with another fabric's law.
+  // Refused: without a checkpoint, with checkpoints, with the penalty coupling, into the
+  // checkpoint's own directory, a hold without a speed, from a run with another fabric's law.
   sc::drop_config bad = c;
   bad.captive_speed = 7.0;
   bad.checkpoint_every = 0;
+  bad.out = (base / "bad").string();
   CHECK_THROWS_WITH_AS(sc::run_drop(bad), doctest::Contains("--captive holds the canopy in the shape of a checkpoint"),
                        parafsi::invalid_input);
   bad.restart = ckpt;
   bad.checkpoint_every = 0.1;
   CHECK_THROWS_WITH_AS(sc::run_drop(bad), doctest::Contains("--captive writes no checkpoint"), parafsi::invalid_input);
+  bad.checkpoint_every = 0;
+  bad.coupling = "penalty";
+  CHECK_THROWS_WITH_AS(sc::run_drop(bad), doctest::Contains("use --coupling embedded"), parafsi::invalid_input);
+  bad.coupling = "embedded";
+  bad.out = (base / "a").string();  // the checkpoint's own run
+  CHECK_THROWS_WITH_AS(sc::run_drop(bad), doctest::Contains("the directory of the checkpoint's own run"),
+                       parafsi::invalid_input);
+  sc::drop_config loose = c;
+  loose.checkpoint_every = 0;
+  loose.captive_hold = "payload";
+  CHECK_THROWS_WITH_AS(sc::run_drop(loose), doctest::Contains("--captive-hold payload needs --captive SPEED"),
+                       parafsi::invalid_input);
   sc::drop_config swapped = c;
   swapped.permeability = "mat509";
   swapped.t_end = 0.02;

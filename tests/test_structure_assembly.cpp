@@ -215,6 +215,10 @@ TEST_CASE("hold(V, bodies): the body translates at V, its line and membrane move
   a.hold(V, scope::bodies);
   CHECK(a.held_scope() == scope::bodies);
   const auto& b = a.part<2>().body();
+  // The body takes V at once, its spin stops, its node goes with it.
+  CHECK((b.mass_centre_velocity() - V).norm() <= 1e-15 * V.norm());
+  CHECK(b.angular_velocity_world().norm() == 0.0);
+  CHECK((a.node_set().velocity(hang) - V).norm() <= 1e-15 * V.norm());
   const Eigen::Vector3d c0 = b.mass_centre(), x1 = a.node_set().position(1);
   const Eigen::Quaterniond q0 = b.attitude();
   const double dt = 0.5 * a.stable_dt();

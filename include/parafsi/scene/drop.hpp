@@ -68,6 +68,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <system_error>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -313,13 +314,21 @@ struct drop_config {
     require(box != "fixed" || fixed_fall > 0,
             "parachute_drop: a fixed box needs the fall length it must hold (> 0 m), got ", fixed_fall);
     require(captive_speed >= 0 && captive_speed <= 200,
-            "parachute_drop: --captive speed must be in [0, 200] m/s (0: "
-            "off), got ",
-            captive_speed);
+            "parachute_drop: --captive speed must be in [0, 200] m/s (0: off), got ", captive_speed);
+    require(captive_speed > 0 || captive_hold == "structure", "parachute_drop: --captive-hold ", captive_hold,
+            " needs --captive SPEED");
     if (captive_speed > 0) {
       require(!restart.empty(),
-              "parachute_drop: --captive holds the canopy in the shape of a checkpoint: give "
-              "--restart FILE");
+              "parachute_drop: --captive holds the canopy in the shape of a checkpoint: give --restart FILE");
+      require(coupling == "embedded",
+              "parachute_drop: --captive reads the canopy's drag from cloth_pressure.csv, which the embedded "
+              "coupling writes: use --coupling embedded");
+      // The free run's files would be cut at the checkpoint's time and replaced.
+      std::error_code ec;
+      const std::filesystem::path from = std::filesystem::path(restart).parent_path();
+      require(out.empty() || !std::filesystem::equivalent(from.empty() ? std::filesystem::path(".") : from, out, ec),
+              "parachute_drop: --captive writes into --out ", out,
+              ", the directory of the checkpoint's own run: give another --out (its history would be replaced)");
       require(checkpoint_every == 0,
               "parachute_drop: --captive writes no checkpoint (the hold is not saved); drop "
               "--checkpoint-every");
@@ -476,21 +485,30 @@ inline std::string drop_fabric_label(const drop_config& c, const drop_setup& su)
   return label;
 }
 
-/// The rings of cloth_bands.csv: the canopy's cut pattern from the vent edge R_v to the
-/// skirt R_s in cloth_band_count rings of equal width, ring 0 at the vent (the crown) and the
-/// last at the skirt; each canopy triangle goes by its centroid's radius on the pattern, so a
-/// ring is the same cloth whatever the canopy's shape. Returned per triangle of the scene
-/// (−1 for a triangle that is not the canopy's).
+/// The rings of cloth_bands.csv: the canopy's cut pattern from the vent edge to the skirt in
+/// cloth_band_count rings of equal width along the seams, ring 0 at the vent (the crown) and
+/// the last at the skirt. A triangle goes by its centroid's seam distance, the distance along
+/// the seams of the pattern's row through it, s = r cos(φ − φ_c)/cos(π/N) (r, φ its polar
+/// coordinates on the pattern, φ_c the centreline of its gore; the rows are chords of the
+/// gores, model::flat_circular_canopy), so the ring boundaries follow the rows and a ring is
+/// the same cloth whatever the canopy's shape. Returned per triangle of the scene (−1 for one
+/// that is not the canopy's).
 inline constexpr int cloth_band_count = 4;
 inline std::vector<int> cloth_bands(const model::drop_scene& sc) {
   std::vector<int> band(sc.triangles.size(), -1);
-  const auto& pat = sc.canopy.positions;
-  const double Rv = sc.canopy.vent_radius, Rs = sc.canopy.skirt_radius;
-  for (std::size_t e = 0; e < sc.triangles.size(); ++e) {
+  const auto& cm = sc.canopy;
+  const auto& pat = cm.positions;
+  const int N = cm.params.gores;
+  const double Rv = cm.vent_radius, Rs = cm.skirt_radius, half = std::numbers::pi / N;
+  for (std::size_t e = 0; e < sc.triangles.size() && e < cm.triangles.size() && e < cm.gore.size(); ++e) {
     const auto& t = sc.triangles[e];
-    if (std::size_t(t[0]) >= pat.size() || std::size_t(t[1]) >= pat.size() || std::size_t(t[2]) >= pat.size()) continue;
+    if (t != cm.triangles[e] || std::size_t(t[0]) >= pat.size() || std::size_t(t[1]) >= pat.size() ||
+        std::size_t(t[2]) >= pat.size())
+      continue;
     const Eigen::Vector3d c = (pat[std::size_t(t[0])] + pat[std::size_t(t[1])] + pat[std::size_t(t[2])]) / 3.0;
-    const double u = (std::hypot(c.x(), c.y()) - Rv) / (Rs - Rv);
+    const double phi_c = 2.0 * half * (cm.gore[e] + 0.5);
+    const double seam = std::hypot(c.x(), c.y()) * std::cos(std::atan2(c.y(), c.x()) - phi_c) / std::cos(half);
+    const double u = (seam - Rv) / (Rs - Rv);
     band[e] = std::clamp(int(std::floor(u * cloth_band_count)), 0, cloth_band_count - 1);
   }
   return band;
@@ -713,6 +731,10 @@ class drop_run {
     using scope = structure::drop_assembly::hold_scope;
     const bool whole = c_.captive_hold == "structure";
     s_.structure().hold(V, whole ? scope::structure : scope::bodies);
+    if (!c_.quiet && whole)
+      std::fprintf(stderr,
+                   "parachute_drop: captive canopy: the riser force, C_D, v_T and descent mode of history.csv and "
+                   "summary.csv describe the held structure, not a descent\n");
     if (!c_.quiet)
       std::fprintf(stderr,
                    "parachute_drop: captive canopy: %s at t = %.6g s, moving at %.4g m/s along the canopy's axis "
@@ -804,9 +826,10 @@ class drop_run {
         });
         const double bw = b.windward_pressure - q_inf, bl = b.leeward_pressure - q_inf;
         const bool bseen = b.projected_area > 0 && moving;
-        row.insert(row.end(), {b.projected_area, bseen ? bw / q : nan, bseen ? bl / q : nan,
-                               bseen ? (bw - bl) * b.projected_area / (q * su_.params.nominal_area()) : 0.0,
-                               moving ? b.through_flow / (v * cs.projected_area) : nan});
+        row.insert(row.end(),
+                   {b.projected_area, bseen ? bw / q : nan, bseen ? bl / q : nan,
+                    bseen ? (bw - bl) * b.projected_area / (q * su_.params.nominal_area()) : (moving ? 0.0 : nan),
+                    moving ? b.through_flow / (v * cs.projected_area) : nan});
       }
       bands_csv_->row(row);
     } else {

@@ -22,7 +22,8 @@
 /// `critical_dt(const nodes&)`, `strain_energy()`, `first_bad_element()` and
 /// optionally `post_finalize(const nodes&)`, `add_node_stiffness(vector&)`,
 /// `damping_ratio()`; body parts (`is_body = true`) provide `finalize`,
-/// `post_finalize`, `place_nodes`, `step`, `translate(V, dt)`, `critical_dt(ksum)` and momenta/energy.
+/// `post_finalize`, `place_nodes`, `step`, `hold(nodes, V)`, `translate(V, dt)`, `critical_dt(ksum)` and
+/// momenta/energy.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -183,14 +184,27 @@ class assembly {
   /// With hold_scope::bodies only the rigid bodies translate at V (attitude kept); the
   /// nodes they carry follow them and every other node moves under its loads as before: a
   /// canopy on a held payload, free to breathe and to turn about its lines, as in a wind
-  /// tunnel. Not saved by a checkpoint: hold again after a load. release_hold() returns to
-  /// the free update.
+  /// tunnel (the other nodes keep their velocities: a start that differs from V is
+  /// impulsive). The bodies (and with hold_scope::structure every node) take the velocity V
+  /// at once. While held, the energy ledger's external work leaves out the work of the hold
+  /// (what holds the structure does work on it), so its balance() is not conserved. Not
+  /// saved by a checkpoint: hold again after a load. release_hold() returns to the free
+  /// update.
   void hold(const Eigen::Vector3d& V, hold_scope scope = hold_scope::structure) {
     require(V.allFinite(), "assembly::hold: non-finite velocity (", V.transpose(), ")");
     if (nodes_.needs_finalize()) finalize();
     held_ = true;
     hold_scope_ = scope;
     hold_velocity_ = V;
+    std::apply(
+        [&](auto&... p) {
+      (
+          (void)[&] {
+            if constexpr (body_part<std::remove_cvref_t<decltype(p)>>) p.hold(nodes_, V);
+          }(),
+          ...);
+        },
+        parts_);
     if (scope == hold_scope::bodies) return;
     auto& s = nodes_.data();
     for (index_t i = 0; i < nodes_.size(); ++i) {

@@ -96,6 +96,12 @@ class attachment {
     return dt_kick * fg.dot(0.5 * (p0 + p1) / body_.mass());
   }
 
+  /// The start of a hold (assembly::hold): the body moves at V without spin from now on, and
+  /// its nodes with it.
+  void hold(nodes& nd, const Eigen::Vector3d& V) {
+    body_.set_translation_velocity(V);
+    place_nodes(nd);
+  }
   /// The held step (assembly::hold): the body translates at V over dt whatever the
   /// node forces on it (rigid_body::translate); returns the external work, 0.
   double translate(const Eigen::Vector3d& V, double dt) {

@@ -260,6 +260,15 @@ class rigid_body {
                               -1, s_.time);
   }
 
+  /// The velocity of a held body (structure::assembly::hold): P = m V, no spin (L = ω_b = 0,
+  /// the mid-step attitude the attitude), the pose kept.
+  void set_translation_velocity(const Eigen::Vector3d& V) {
+    require(V.allFinite(), "rigid_body::set_translation_velocity: non-finite velocity (", V.transpose(), ")");
+    s_.p = s_.mass * V;
+    s_.l.setZero();
+    s_.omega_body.setZero();
+    s_.q_half = s_.q;
+  }
   /// A step of length dt as a rigid translation at the velocity V, whatever the loads:
   /// the mass centre moves by V dt, the attitude stays, P = m V and L = ω_b = 0 (the
   /// body held captive, structure::assembly::hold). The pending loads are cleared.
@@ -268,10 +277,7 @@ class rigid_body {
     require(V.allFinite(), "rigid_body::translate: non-finite velocity (", V.transpose(), ")");
     clear_loads();
     s_.x_com += dt * V;
-    s_.p = s_.mass * V;
-    s_.l.setZero();
-    s_.omega_body.setZero();
-    s_.q_half = s_.q;
+    set_translation_velocity(V);
     s_.dt_prev = dt;
     s_.time += dt;
     ++s_.steps;

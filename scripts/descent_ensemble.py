@@ -12,6 +12,9 @@ fabric at --grid-offset 0, 0.25, 0.5, and gives:
 * per run, over --window: mean payload speed, mean drag_coefficient (2 W / (rho v^2 S0)),
   the rms canopy tilt (degrees, from canopy_phi_x and canopy_phi_y of history.csv) and the
   mean canopy_diameter (the skirt's; C_D on the projected area is C_D (D0 / D)^2);
+* per run, when the histories hold the velocity: the canopy axis's angle to the flight path
+  (rms, mean, largest; the angle of attack, which a gliding canopy keeps: validation.md
+  section 3.7);
 * per group: the number of runs n, the mean of each, its sample standard deviation s and
   the standard error s / sqrt(n);
 * per pair of groups: the difference of the mean C_D with its standard error
@@ -86,6 +89,28 @@ def windows(a, lo, hi, sub):
     tilt = np.hypot(a["canopy_phi_x"], a["canopy_phi_y"])
     return [(np.sqrt(np.mean(tilt[m] ** 2)), a["drag_coefficient"][m].mean(), a["speed"][m].mean())
             for m in window_masks(a["t"], lo, hi, sub)]
+
+
+def angle_of_attack(a, lo, hi):
+    """(rms, mean, largest) angle (deg) between the canopy axis and the flight path over [lo, hi], or None.
+
+    The axis a = (tan phi_y, -tan phi_x, 1)/|.| from canopy_phi_x, canopy_phi_y (io::axis_angles, an
+    axis with a_z > 0), the stream e = -V/|V| from vx, vy, vz: the angle the canopy flies at to its path
+    (its angle of attack; a trimmed, gliding canopy keeps one, validation.md section 3.7)."""
+    if not all(c in a.dtype.names for c in ("vx", "vy", "vz")):
+        return None
+    m = (a["t"] >= lo) & (a["t"] <= hi)
+    ax = np.stack([np.tan(np.radians(a["canopy_phi_y"][m])), -np.tan(np.radians(a["canopy_phi_x"][m])),
+                   np.ones(int(m.sum()))], axis=1)
+    ax /= np.linalg.norm(ax, axis=1)[:, None]
+    v = np.stack([a["vx"][m], a["vy"][m], a["vz"][m]], axis=1)
+    speed = np.linalg.norm(v, axis=1)
+    ok = speed > 0
+    if not ok.any():
+        return None
+    e = -v[ok] / speed[ok][:, None]
+    ang = np.degrees(np.arccos(np.clip(np.sum(ax[ok] * e, axis=1), -1.0, 1.0)))
+    return np.sqrt(np.mean(ang ** 2)), ang.mean(), ang.max()
 
 
 def cloth_windows(run_dir, lo, hi, sub):
@@ -203,7 +228,7 @@ def main():
     lo, hi = o.window
     if not hi > lo or o.sub < 0 or (o.sub and o.sub > hi - lo):
         sys.exit("descent_ensemble: the window's end must follow its start, and 0 <= --sub <= its length")
-    rows, points, side_points = [], [], []
+    rows, points, side_points, aoa = [], [], [], {}
     for r in o.runs:
         path, a = load(r)
         require_finite(path, a, lo)
@@ -218,6 +243,7 @@ def main():
         win = (a["t"] >= lo) & (a["t"] <= hi)
         diameter = a["canopy_diameter"][win].mean() if "canopy_diameter" in a.dtype.names else np.nan
         rows.append((g, run_dir, v, cd, tilt, opening(run_dir), diameter, cloth_means(run_dir, lo, hi)))
+        aoa[run_dir] = angle_of_attack(a, lo, hi)
         sw = windows(a, lo, hi, o.sub)
         points += [(g, th, c) for th, c, _ in sw]
         cw = cloth_windows(run_dir, lo, hi, o.sub) if rows[-1][7] is not None else None
@@ -233,6 +259,12 @@ def main():
     print("group run v cd tilt_rms diameter")
     for g, d, v, cd, tilt, _, dia, _ in sorted(rows, key=lambda r: r[:2]):
         print(f"{g} {d} {v:.4f} {cd:.4f} {tilt:.2f} {dia:.4f}")
+    if all(x is not None for x in aoa.values()):
+        print("# per run: the canopy axis's angle to the flight path (deg), rms, mean and largest over the window "
+              "(its angle of attack: a trimmed canopy keeps one; the tilt above is from the vertical)")
+        print("group run aoa_rms aoa_mean aoa_max")
+        for g, d, *_ in sorted(rows, key=lambda r: r[:2]):
+            print(f"{g} {d} {aoa[d][0]:.2f} {aoa[d][1]:.2f} {aoa[d][2]:.2f}")
     print("# per group: n, mean, sample standard deviation s, standard error s/sqrt(n)")
     print("group n v_mean v_s cd_mean cd_s cd_se tilt_mean tilt_s diameter_mean diameter_s")
     summary = {}

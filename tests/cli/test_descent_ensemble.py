@@ -105,6 +105,12 @@ def main():
         check(r.returncode == 0, f"exit {r.returncode}: {r.stderr}")
         out = r.stdout
         runs = {os.path.basename(w[1]): w for w in table(out, "group run v cd tilt_rms diameter")}
+        # The synthetic canopy tilts about X by `tilt` while the payload falls straight down:
+        # its angle to the flight path is the tilt, at every row.
+        aoa = {os.path.basename(w[1]): w for w in table(out, "group run aoa_rms aoa_mean aoa_max")}
+        for name, (fabric, tilt, cd, v) in RUNS.items():
+            w = aoa[name]
+            check(all(close(x, tilt, 1e-3) for x in w[2:5]), f"angle to the path of {name}: {w} against {tilt}")
         for name, (fabric, tilt, cd, v) in RUNS.items():
             w = runs[name]
             check(w[0] == fabric and close(w[2], v, 1e-4) and close(w[3], cd, 1e-4) and close(w[4], tilt, 1e-3),

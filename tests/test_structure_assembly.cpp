@@ -1,6 +1,7 @@
 // Assembly composition (leave-out), energy balance, and the rigid-body attachment.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <tuple>
@@ -125,29 +126,37 @@ TEST_CASE("a payload spinning at 100 rad/s with a riser stays stable") {
   CHECK(a.node_set().position(hang).z() > 0.05);
 }
 
-TEST_CASE("hold(V): a captive structure translates rigidly at V whatever its loads; release_hold() frees it") {
-  // A loaded, moving membrane + line + spinning body held captive (the drop's --captive):
-  // each node and the body's mass centre move by exactly V t, the attitude stays, the load
-  // hook still runs every substep.
+/// A membrane triangle (nodes 0–2 at x, v), a line from node 0 to node 3, and node 3 tied
+/// to a 2 kg body at the body point `hang` (the body at the origin with attitude q, velocity
+/// vb, angular velocity wb): the rig of the hold tests.
+namespace {
+auto line_rig(const std::array<Eigen::Vector3d, 3>& x, const std::array<Eigen::Vector3d, 3>& v,
+              const Eigen::Vector3d& hang, const Eigen::Quaterniond& q, const Eigen::Vector3d& vb,
+              const Eigen::Vector3d& wb) {
   st::nodes nd;
-  nd.add({0, 0, 1}, {0.3, 0, 0});
-  nd.add({1, 0, 1}, {0, -0.2, 0});
-  nd.add({0, 1, 1.2}, {0, 0, 0.5});
-  const index_t hang = nd.add({0.1, 0.0, 0.0});
+  for (int k = 0; k < 3; ++k) nd.add(x[std::size_t(k)], v[std::size_t(k)]);
+  const index_t tie = nd.add(hang);
   st::triangle_mesh m;
   m.triangles = {{0, 1, 2}};
-  st::attachment body{st::rigid_body{st::rigid_body::cuboid(2.0, {0.4, 0.3, 0.2}),
-                                     {0, 0, 0},
-                                     Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX())),
-                                     {0.1, 0.2, -0.4},
-                                     {1.0, 0.0, 3.0}}};
-  body.attach(hang, {0.1, 0.0, 0.0});
+  st::attachment body{st::rigid_body{st::rigid_body::cuboid(2.0, {0.4, 0.3, 0.2}), {0, 0, 0}, q, vb, wb}};
+  body.attach(tie, hang);
   st::assembly a{std::move(nd),
                  st::membrane_tri{m,
                                   st::material::fabric<st::wrinkling::none>::isotropic(1e7, 0.3, 0.05, 1e-4),
                                   {0.05}},
-                 st::cable{st::line_mesh{{{hang, 0}}, {0.8}}, st::material::cable{5e3, 0.05, 0.1, 0}}, std::move(body)};
+                 st::cable{st::line_mesh{{{tie, 0}}, {0.8}}, st::material::cable{5e3, 0.05, 0.1, 0}}, std::move(body)};
   a.finalize();
+  return a;
+}
+}  // namespace
+
+TEST_CASE("hold(V): a captive structure translates rigidly at V whatever its loads; release_hold() frees it") {
+  // A loaded, moving membrane + line + spinning body held captive (the drop's --captive):
+  // each node and the body's mass centre move by exactly V t, the attitude stays, the load
+  // hook still runs every substep.
+  auto a = line_rig({{{0, 0, 1}, {1, 0, 1}, {0, 1, 1.2}}}, {{{0.3, 0, 0}, {0, -0.2, 0}, {0, 0, 0.5}}}, {0.1, 0.0, 0.0},
+                    Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX())), {0.1, 0.2, -0.4},
+                    {1.0, 0.0, 3.0});
   const Eigen::Vector3d V(0.4, -1.5, -7.0);
   a.hold(V);
   CHECK(a.held());
@@ -191,25 +200,10 @@ TEST_CASE("hold(V, bodies): the body translates at V, its line and membrane move
   // A canopy on a held payload (the drop's --captive-hold payload): the body keeps its
   // attitude and moves at V whatever the line pulls; the node tied to it follows it; the
   // free nodes are integrated (gravity and the taut line move them off the translation).
-  st::nodes nd;
-  nd.add({0, 0, 1});
-  nd.add({1, 0, 1});
-  nd.add({0, 1, 1});
-  const index_t hang = nd.add({0.0, 0.0, 0.0});
-  st::triangle_mesh m;
-  m.triangles = {{0, 1, 2}};
-  st::attachment body{st::rigid_body{st::rigid_body::cuboid(2.0, {0.4, 0.3, 0.2}),
-                                     {0, 0, 0},
-                                     Eigen::Quaterniond::Identity(),
-                                     {0, 0, 0},
-                                     {0.0, 2.0, 0.0}}};
-  body.attach(hang, {0.0, 0.0, 0.0});
-  st::assembly a{std::move(nd),
-                 st::membrane_tri{m,
-                                  st::material::fabric<st::wrinkling::none>::isotropic(1e7, 0.3, 0.05, 1e-4),
-                                  {0.05}},
-                 st::cable{st::line_mesh{{{hang, 0}}, {0.8}}, st::material::cable{5e3, 0.05, 0.1, 0}}, std::move(body)};
-  a.finalize();
+  auto a = line_rig({{{0, 0, 1}, {1, 0, 1}, {0, 1, 1}}},
+                    {{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}}, {0.0, 0.0, 0.0},
+                    Eigen::Quaterniond::Identity(), {0, 0, 0}, {0.0, 2.0, 0.0});
+  const index_t hang = 3;
   const Eigen::Vector3d V(0.0, 0.0, -7.0);
   using scope = decltype(a)::hold_scope;
   a.hold(V, scope::bodies);
